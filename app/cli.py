@@ -1,0 +1,121 @@
+"""The ``rsg`` command line: ``rsg run`` (and later ``demo``, ``sweep``, ``bench``)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from planner.exceptions import RsgError
+from planner.parameters import CONTROLLERS
+
+from .scenarios import BUILT_IN, parse_push
+
+MODELS = ("lipm", "pybullet")
+DEFAULT_MODEL = "lipm"
+
+RUN_EPILOG = """\
+examples:
+  rsg run --model lipm --scenario paper-fig6 --out results/fig6
+  rsg run --model lipm --controller no-step --scenario walk --push 3:0,25 --out results/side
+  rsg run --model lipm --scenario my_pushes.toml --out results/mine
+
+outputs in --out:
+  summary.json     verdict (recovered, fell), steps, pushes, Lyapunov levels, counts
+  timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
+  fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
+"""
+
+
+def _push(text: str):
+    try:
+        return parse_push(text)
+    except RsgError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _positive_seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--duration={text!r}: expected seconds > 0") from None
+    if not 0.0 < value <= 3600.0:
+        raise argparse.ArgumentTypeError(f"--duration={value}: expected seconds in (0, 3600]")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="rsg",
+        description="Reactive step generation for biped push recovery (Lyapunov-based hybrid "
+        "tracking control of the DCM), on the LIPM and on a full humanoid in PyBullet.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    run = sub.add_parser(
+        "run",
+        help="simulate one scenario headless and write summary, time series and plots",
+        description="Simulate one scenario with a step controller in the loop, headless, and "
+        "write summary.json, timeseries.csv and the paper's Fig. 6 plots to --out.",
+        epilog=RUN_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    run.add_argument(
+        "--model",
+        choices=MODELS,
+        default=DEFAULT_MODEL,
+        help=f"simulation backend (default: {DEFAULT_MODEL})",
+    )
+    run.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    run.add_argument(
+        "--controller",
+        choices=CONTROLLERS,
+        default="rsg",
+        help="rsg: step time and location adjusted; fixed-timing: location only; "
+        "no-step: nominal steps (default: rsg)",
+    )
+    run.add_argument(
+        "--scenario",
+        default="paper-fig6",
+        help=f"built-in ({', '.join(BUILT_IN)}) or a .toml file (default: paper-fig6)",
+    )
+    run.add_argument(
+        "--push",
+        type=_push,
+        action="append",
+        default=[],
+        metavar="T:IX,IY[:D]",
+        help="add a push: start time [s], impulse [N s], duration [s] (default 0.1); repeatable",
+    )
+    run.add_argument(
+        "--duration",
+        type=_positive_seconds,
+        default=None,
+        help="simulated time [s] (default: the scenario's)",
+    )
+    run.add_argument("--out", type=Path, required=True, help="folder for the results")
+    run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of ``rsg``; returns the exit code (0 ok, 1 not recovered, 2 bad input)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        if args.command == "run":
+            from .run_command import run_command
+
+            return run_command(args)
+    except RsgError as exc:
+        print(f"rsg {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"rsg {args.command}: interrupted", file=sys.stderr)
+        return 130
+    parser.error(f"unknown command {args.command}")
+    return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

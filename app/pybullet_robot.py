@@ -1,0 +1,207 @@
+"""A biped in its own PyBullet world: loading, state measurement, actuation.
+
+One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
+coexist in a process), a flat ground with friction, and the robot loaded from the
+derived URDF with the URDF's inertias. Frames: PyBullet's base pose is the base
+link's *inertial* frame; :meth:`base_pose` converts it to the URDF base frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pybullet
+import pybullet_data
+from numpy.typing import NDArray
+from pybullet_utils.bullet_client import BulletClient
+
+from robots.description import RobotDescription
+from robots.urdf_cache import derived_urdf
+
+GRAVITY = 9.81  # [m/s^2]
+PHYSICS_TIME_STEP = 1e-3  # [s]
+SOLVER_ITERATIONS = 50
+
+
+class SimulatedRobot:
+    """The robot and the ground in one PyBullet client.
+
+    Attributes:
+        joint_names: Actuated (revolute) joint names, in PyBullet index order.
+        link_masses: Mass of each body part [kg]; index 0 is the base.
+        mass: Total mass [kg].
+        foot_links: Foot -> PyBullet link index of its ankle link.
+    """
+
+    def __init__(self, description: RobotDescription) -> None:
+        self.description = description
+        self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        client = self.client
+        client.setGravity(0.0, 0.0, -GRAVITY)
+        client.setPhysicsEngineParameter(
+            fixedTimeStep=PHYSICS_TIME_STEP,
+            numSolverIterations=SOLVER_ITERATIONS,
+            deterministicOverlappingPairs=1,
+        )
+        client.setAdditionalSearchPath(pybullet_data.getDataPath())
+        self.ground = client.loadURDF("plane.urdf", useFixedBase=True)
+        client.changeDynamics(self.ground, -1, lateralFriction=description.ground_friction)
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+        self.body = client.loadURDF(str(derived_urdf(description)), [0, 0, 1], flags=flags)
+
+        self.joint_indices: list[int] = []
+        self.joint_names: list[str] = []
+        link_index = {client.getBodyInfo(self.body)[0].decode(): -1}
+        for index in range(client.getNumJoints(self.body)):
+            info = client.getJointInfo(self.body, index)
+            link_index[info[12].decode()] = index
+            if info[2] == pybullet.JOINT_REVOLUTE:
+                self.joint_indices.append(index)
+                self.joint_names.append(info[1].decode())
+            client.setJointMotorControl2(self.body, index, pybullet.VELOCITY_CONTROL, force=0.0)
+        self._link_names = {index: name for name, index in link_index.items()}
+        self.foot_links = {
+            foot: link_index[description.ankle_link(foot)] for foot in ("left", "right")
+        }
+        for link in self.foot_links.values():
+            client.changeDynamics(
+                self.body, link, lateralFriction=description.ground_friction, frictionAnchor=1
+            )
+        self.link_count = client.getNumJoints(self.body)
+        self.link_masses = np.array(
+            [client.getDynamicsInfo(self.body, link)[0] for link in range(-1, self.link_count)]
+        )
+        self.mass = float(self.link_masses.sum())
+        base_info = client.getDynamicsInfo(self.body, -1)
+        self._base_inertial = (base_info[3], base_info[4])
+        gains = [description.gains_of(name) for name in self.joint_names]
+        self._position_gains = [g.position_gain for g in gains]
+        self._velocity_gains = [g.velocity_gain for g in gains]
+        self._max_forces = [g.max_force for g in gains]
+        self.time = 0.0
+
+    # ----------------------------------------------------------------- state
+    def set_configuration(
+        self,
+        base_position: NDArray[np.float64],
+        base_quaternion_xyzw: Sequence[float],
+        joint_angles: Mapping[str, float],
+        base_linear_velocity: NDArray[np.float64] | None = None,
+        base_angular_velocity: NDArray[np.float64] | None = None,
+        joint_velocities: Mapping[str, float] | None = None,
+    ) -> None:
+        """Teleport the robot to a configuration of its URDF base frame.
+
+        Args:
+            base_position: Base frame origin [m].
+            base_quaternion_xyzw: Base frame orientation.
+            joint_angles: Joint name -> angle [rad] (missing: 0).
+            base_linear_velocity: Velocity of the base frame origin [m/s].
+            base_angular_velocity: Base angular velocity in the world [rad/s].
+            joint_velocities: Joint name -> velocity [rad/s] (missing: 0).
+        """
+        position, orientation = self.client.multiplyTransforms(
+            list(base_position), list(base_quaternion_xyzw), *self._base_inertial
+        )
+        self.client.resetBasePositionAndOrientation(self.body, position, orientation)
+        linear = np.zeros(3) if base_linear_velocity is None else base_linear_velocity
+        angular = np.zeros(3) if base_angular_velocity is None else base_angular_velocity
+        # PyBullet's base velocity is that of the inertial frame origin.
+        offset = np.array(position) - np.asarray(base_position, float)
+        linear = np.asarray(linear, float) + np.cross(angular, offset)
+        self.client.resetBaseVelocity(self.body, list(linear), list(angular))
+        velocities = joint_velocities or {}
+        for name, index in zip(self.joint_names, self.joint_indices, strict=True):
+            self.client.resetJointState(
+                self.body, index, joint_angles.get(name, 0.0), velocities.get(name, 0.0)
+            )
+
+    def base_pose(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m] and quaternion (x, y, z, w) of the URDF base frame."""
+        position, orientation = self.client.getBasePositionAndOrientation(self.body)
+        inverse = self.client.invertTransform(*self._base_inertial)
+        frame_position, frame_orientation = self.client.multiplyTransforms(
+            position, orientation, *inverse
+        )
+        return np.array(frame_position), np.array(frame_orientation)
+
+    def joint_angles(self) -> dict[str, float]:
+        """Joint name -> measured angle [rad]."""
+        states = self.client.getJointStates(self.body, self.joint_indices)
+        return {name: state[0] for name, state in zip(self.joint_names, states, strict=True)}
+
+    def com_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Whole-body CoM position [m] and velocity [m/s] in the world, shape (3,) each."""
+        base_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        base_velocity, _ = self.client.getBaseVelocity(self.body)
+        states = self.client.getLinkStates(
+            self.body, list(range(self.link_count)), computeLinkVelocity=1
+        )
+        positions = np.array([base_position] + [state[0] for state in states])
+        velocities = np.array([base_velocity] + [state[6] for state in states])
+        com = self.link_masses @ positions / self.mass
+        com_velocity = self.link_masses @ velocities / self.mass
+        return com, com_velocity
+
+    def ground_contacts(self) -> set[int]:
+        """PyBullet link indices touching the ground (-1: the base)."""
+        points = self.client.getContactPoints(bodyA=self.body, bodyB=self.ground)
+        return {point[3] for point in points}
+
+    def feet_in_contact(self) -> set[str]:
+        """Feet whose ankle link touches the ground."""
+        contacts = self.ground_contacts()
+        return {foot for foot, link in self.foot_links.items() if link in contacts}
+
+    def link_name(self, link: int) -> str:
+        """URDF name of PyBullet link index ``link`` (-1: the base)."""
+        return self._link_names.get(link, str(link))
+
+    def sole_position(self, foot: str) -> NDArray[np.float64]:
+        """World position [m] of the sole frame origin of ``foot``, shape (3,)."""
+        state = self.client.getLinkState(
+            self.body, self.foot_links[foot], computeForwardKinematics=1
+        )
+        rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        return np.array(state[4]) + rotation @ np.array(self.description.sole_offset)
+
+    # ------------------------------------------------------------- actuation
+    def set_joint_targets(
+        self, angles: NDArray[np.float64], velocities: NDArray[np.float64] | None = None
+    ) -> None:
+        """Position targets [rad] (and velocity targets [rad/s]) in joint_names order."""
+        target_velocities = np.zeros(len(angles)) if velocities is None else velocities
+        self.client.setJointMotorControlArray(
+            self.body,
+            self.joint_indices,
+            pybullet.POSITION_CONTROL,
+            targetPositions=list(angles),
+            targetVelocities=list(target_velocities),
+            positionGains=self._position_gains,
+            velocityGains=self._velocity_gains,
+            forces=self._max_forces,
+        )
+
+    def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
+        """One physics step of PHYSICS_TIME_STEP [s] with a force [N] on the base CoM.
+
+        PyBullet clears external forces after each step, so a push lasting several
+        steps must be applied at every step.
+        """
+        if base_force_world is not None and np.any(base_force_world):
+            position, _ = self.client.getBasePositionAndOrientation(self.body)
+            self.client.applyExternalForce(
+                self.body, -1, list(base_force_world), position, pybullet.WORLD_FRAME
+            )
+        self.client.stepSimulation()
+        self.time += PHYSICS_TIME_STEP
+
+    def close(self) -> None:
+        """Disconnect the PyBullet client (idempotent)."""
+        if self.client is not None:
+            try:
+                self.client.disconnect()
+            except pybullet.error:
+                pass
+            self.client = None  # type: ignore[assignment]

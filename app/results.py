@@ -1,0 +1,97 @@
+"""Writing a run's results: summary.json, timeseries.csv and the Fig. 6 plots."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from planner.exceptions import RsgError
+
+from .runner import TIMESERIES_COLUMNS, RunResult
+
+
+def summary_of(result: RunResult, controller: str) -> dict:
+    """The run's summary as a JSON-ready dict (see the README for each field)."""
+    config = result.config
+    return {
+        "recovered": bool(result.recovered),
+        "fell": bool(result.fall.fell),
+        "fall_reason": result.fall.reason,
+        "model": result.backend,
+        "controller": controller,
+        "scenario": result.scenario.name,
+        "mass": float(result.mass),
+        "com_height": float(result.com_height),
+        "gamma_v": float(result.lyapunov_threshold),
+        "final_lyapunov": result.final_lyapunov,
+        "max_lyapunov": result.max_lyapunov,
+        "impulse_scale": float(result.impulse_scale),
+        "impulse_scale_note": (
+            f"impulses scaled by {result.impulse_scale:.4f} = robot mass / "
+            f"{result.scenario.reference_mass} kg so the velocity change matches"
+            if result.impulse_scale != 1.0
+            else ""
+        ),
+        "pushes": [p.as_dict() for p in result.scenario.pushes],
+        "steps": [dict(s.event, step=s.step) for s in result.steps],
+        "adjusted_steps": int(sum(s.event["adjusted"] for s in result.steps)),
+        "qp_infeasible": int(result.qp_infeasible),
+        "constraint_violations": result.constraint_violations,
+        "constraint_violations_by_kind": dict(result.violations),
+        "sim_time": float(result.sim_time),
+        "wall_time": float(result.wall_time),
+        "real_time_factor": float(result.sim_time / result.wall_time)
+        if result.wall_time > 0
+        else None,
+        "parameters": {
+            "stride_length": config.gait.stride_length,
+            "step_width": config.gait.step_width,
+            "double_support_duration": config.gait.double_support_duration,
+            "single_support_duration": config.gait.single_support_duration,
+            "theta": config.rsg.filter_time_constant,
+            "mu_1": config.rsg.step_decrease_margin,
+            "mu_2": config.rsg.crossing_margin,
+            "mu_3": config.rsg.com_margin,
+            "swing_preparation_time": config.rsg.swing_preparation_time,
+            "zmp_window_min": list(config.constraints.zmp_window_min),
+            "zmp_window_max": list(config.constraints.zmp_window_max),
+            "angular_momentum_rate_max": config.constraints.angular_momentum_rate_max,
+            "step_min": list(config.constraints.step_min),
+            "step_max": list(config.constraints.step_max),
+            "lyapunov_matrix": result.extra.get("lyapunov_matrix"),
+            "feedback_gain": result.extra.get("feedback_gain"),
+        },
+        **{k: v for k, v in result.extra.items() if k not in ("lyapunov_matrix", "feedback_gain")},
+    }
+
+
+def write_results(result: RunResult, controller: str, out_dir: Path, plots: bool = True) -> dict:
+    """Write summary.json, timeseries.csv and (optionally) PNG plots into ``out_dir``.
+
+    Returns:
+        The summary dict.
+
+    Raises:
+        RsgError: If the folder cannot be written.
+    """
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        summary = summary_of(result, controller)
+        (out_dir / "summary.json").write_text(json.dumps(summary, indent=2) + "\n")
+        np.savetxt(
+            out_dir / "timeseries.csv",
+            result.timeseries,
+            delimiter=",",
+            header=",".join(TIMESERIES_COLUMNS),
+            comments="",
+            fmt="%.6g",
+        )
+    except OSError as exc:
+        raise RsgError(f"cannot write results to {out_dir}: {exc}") from exc
+    if plots:
+        from .plots import plot_fig6
+
+        plot_fig6(result, out_dir)
+    return summary

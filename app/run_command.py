@@ -1,0 +1,86 @@
+"""``rsg run``: one scenario, headless, results to a folder."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from .results import write_results
+from .runner import RunResult, run_closed_loop
+from .scenarios import load_scenario
+from .setup import build_backend
+
+
+class ProgressBar:
+    """A one-line progress bar on stderr (silent when stderr is not a terminal)."""
+
+    def __init__(self, label: str, enabled: bool = True) -> None:
+        self.label = label
+        self.enabled = enabled and sys.stderr.isatty()
+        self.last = -1
+
+    def __call__(self, fraction: float) -> None:
+        if not self.enabled:
+            return
+        percent = int(100 * fraction)
+        if percent != self.last:
+            self.last = percent
+            bar = "#" * (percent // 4)
+            sys.stderr.write(f"\r{self.label} [{bar:<25}] {percent:3d}%")
+            if percent >= 100:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+
+
+def verdict(result: RunResult) -> str:
+    """One line saying what happened."""
+    adjusted = sum(s.event["adjusted"] for s in result.steps)
+    head = "RECOVERED" if result.recovered else ("FELL" if result.fall.fell else "NOT RECOVERED")
+    why = f" ({result.fall.reason})" if result.fall.fell else ""
+    return (
+        f"{head}{why}: {len(result.steps)} steps ({adjusted} adjusted), "
+        f"V_u final {result.final_lyapunov:.2e} / max {result.max_lyapunov:.2e} "
+        f"(gamma_v {result.lyapunov_threshold:g}), constraint violations "
+        f"{result.constraint_violations}, QP infeasible {result.qp_infeasible}, "
+        f"{result.sim_time:.1f} s simulated in {result.wall_time:.1f} s"
+    )
+
+
+def run_command(args: argparse.Namespace) -> int:
+    """Run ``args.scenario``; returns 0 if recovered, 1 otherwise."""
+    scenario = load_scenario(args.scenario).with_pushes(args.push)
+    if args.duration is not None:
+        scenario = type(scenario)(
+            scenario.name,
+            args.duration,
+            scenario.pushes,
+            scenario.description,
+            scenario.reference_mass,
+        )
+    backend, config, initial = build_backend(args.model, args.robot, args.controller)
+    try:
+        scaled, factor = scenario.scaled_to(backend.mass)
+        if factor != 1.0:
+            print(
+                f"impulses scaled by {factor:.3f} (robot mass {backend.mass:.1f} kg / "
+                f"{scenario.reference_mass:.1f} kg) so the velocity change matches"
+            )
+        result = run_closed_loop(
+            backend,
+            config,
+            scaled,
+            initial,
+            progress=ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet),
+        )
+        result.impulse_scale = factor
+    finally:
+        backend.close()
+    out: Path = args.out
+    summary = write_results(result, args.controller, out, plots=not args.no_plots)
+    for name in ("summary.json", "timeseries.csv"):
+        print(f"wrote {out / name}")
+    if not args.no_plots:
+        print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
+    print(verdict(result))
+    return 0 if summary["recovered"] else 1

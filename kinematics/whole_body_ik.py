@@ -1,0 +1,235 @@
+"""Whole-body inverse kinematics of a biped with placo.
+
+The IK keeps its own kinematic model (floating base + joints) in the world frame
+of the simulation and moves it, once per control tick, so that:
+
+* the stance sole follows its pose exactly (hard frame task);
+* the swing sole follows its pose (soft, high weight);
+* the CoM follows the target [m] (soft, high weight);
+* the trunk and the pelvis stay upright with the feet's mean yaw (soft);
+* the joints stay near the standing posture (soft, low weight), within limits;
+* optionally, the centroidal angular momentum follows a target [N m s] (soft),
+  so the upper body realises the planner's rate of change of angular momentum.
+
+Its output is the joint target vector for the simulator's position control.
+The model is never reset from measurements: the closed loop goes through the CoM
+target, which the caller computes from the measured state.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from typing import Literal
+
+import numpy as np
+import placo
+from numpy.typing import NDArray
+
+from planner.exceptions import ParameterError
+from robots.description import RobotDescription
+from robots.urdf_cache import FOOT_FRAMES, TRUNK_FRAME, derived_urdf
+
+Support = Literal["left", "right", "both"]
+
+FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]
+COM_WEIGHT = 100.0  # CoM task weight [-]
+TRUNK_WEIGHT = 10.0  # trunk and pelvis orientation weight [-]
+POSTURE_WEIGHT = 1e-2  # joint posture regularisation weight [-]
+MOMENTUM_WEIGHT = 1e-2  # centroidal angular momentum weight, when enabled [-]
+
+
+def kinematic_urdf_text(description: RobotDescription) -> str:
+    """The derived URDF without visual/collision geometry (fast to load for IK)."""
+    root = ET.parse(derived_urdf(description)).getroot()
+    for link in root.iter("link"):
+        for tag in ("visual", "collision"):
+            for element in link.findall(tag):
+                link.remove(element)
+    return ET.tostring(root, encoding="unicode")
+
+
+def yaw_rotation(yaw: float) -> NDArray[np.float64]:
+    """Rotation matrix about the world z axis by ``yaw`` [rad]."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def sole_pose(position: NDArray[np.float64], yaw: float = 0.0) -> NDArray[np.float64]:
+    """Homogeneous 4x4 pose of a flat sole at ``position`` (3,) [m] and ``yaw`` [rad]."""
+    pose = np.eye(4)
+    pose[:3, :3] = yaw_rotation(yaw)
+    pose[:3, 3] = position
+    return pose
+
+
+class WholeBodyIK:
+    """placo kinematics solver tracking feet, CoM, trunk and posture targets.
+
+    Attributes:
+        joint_names: Actuated joint names, in the order of :meth:`solve`'s output.
+        robot: The placo model (its state is the last IK solution).
+    """
+
+    def __init__(self, description: RobotDescription, use_angular_momentum: bool = False) -> None:
+        """Build the model and the tasks.
+
+        Args:
+            description: The robot.
+            use_angular_momentum: Add the centroidal angular momentum task fed by
+                :meth:`solve`'s ``angular_momentum`` argument.
+        """
+        self.description = description
+        self.robot = placo.HumanoidRobot(
+            "", placo.Flags.ignore_collisions, kinematic_urdf_text(description)
+        )
+        self.joint_names: list[str] = list(self.robot.joint_names())
+        unknown = set(description.standing_posture) - set(self.joint_names)
+        if unknown:
+            raise ParameterError("standing_posture", sorted(unknown), "joints of the URDF")
+        self.solver = placo.KinematicsSolver(self.robot)
+        self.solver.mask_fbase(False)
+        self.solver.enable_joint_limits(True)
+        self.solver.enable_velocity_limits(False)
+
+        self.foot_tasks = {
+            foot: self.solver.add_frame_task(frame, np.eye(4))
+            for foot, frame in FOOT_FRAMES.items()
+        }
+        self.com_task = self.solver.add_com_task(np.zeros(3))
+        self.com_task.configure("com", "soft", COM_WEIGHT)
+        self.trunk_task = self.solver.add_orientation_task(TRUNK_FRAME, np.eye(3))
+        self.trunk_task.configure("trunk", "soft", TRUNK_WEIGHT)
+        self.pelvis_task = self.solver.add_orientation_task(description.base_link, np.eye(3))
+        self.pelvis_task.configure("pelvis", "soft", TRUNK_WEIGHT)
+        self.posture_task = self.solver.add_joints_task()
+        self.posture_task.set_joints(self.standing_posture())
+        self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
+        self.momentum_task = None
+        if use_angular_momentum:
+            self.momentum_task = self.solver.add_centroidal_momentum_task(np.zeros(3))
+            self.momentum_task.mask.set_axises("xy")
+            self.momentum_task.configure("angular_momentum", "soft", MOMENTUM_WEIGHT)
+        self._support: Support | None = None
+
+    def standing_posture(self) -> dict[str, float]:
+        """Joint name -> standing angle [rad] for every actuated joint."""
+        return {name: self.description.standing_posture.get(name, 0.0) for name in self.joint_names}
+
+    def _configure_support(self, support: Support) -> None:
+        if support == self._support:
+            return
+        for foot, task in self.foot_tasks.items():
+            hard = support in (foot, "both")
+            task.configure(f"{foot}_foot", "hard" if hard else "soft", FOOT_WEIGHT, FOOT_WEIGHT)
+        self._support = support
+
+    def reset(
+        self,
+        left_sole: NDArray[np.float64],
+        right_sole: NDArray[np.float64],
+        com_xy: NDArray[np.float64],
+        iterations: int = 50,
+    ) -> NDArray[np.float64]:
+        """Start from the standing posture and converge on the given targets.
+
+        Args:
+            left_sole: Left sole pose, 4x4 homogeneous [m].
+            right_sole: Right sole pose, 4x4 homogeneous [m].
+            com_xy: Horizontal CoM target [m], shape (2,).
+            iterations: Solver iterations.
+
+        Returns:
+            Joint angles [rad] in :attr:`joint_names` order.
+        """
+        self.robot.reset()
+        for name, angle in self.standing_posture().items():
+            self.robot.set_joint(name, angle)
+        base = np.eye(4)
+        base[:3, 3] = [*np.asarray(com_xy, float), self.description.com_height + 0.1]
+        self.robot.set_T_world_fbase(base)
+        self.robot.update_kinematics()
+        # Soft feet first: a far initial guess must not make hard tasks infeasible.
+        for foot, task in self.foot_tasks.items():
+            task.configure(f"{foot}_foot", "soft", FOOT_WEIGHT, FOOT_WEIGHT)
+        self._support = None
+        self.solver.dt = 0.01
+        for _ in range(iterations):
+            self._set_targets(com_xy, left_sole, right_sole, None)
+            self.solver.solve(True)
+            self.robot.update_kinematics()
+        return self.joint_angles()
+
+    def _set_targets(
+        self,
+        com_xy: NDArray[np.float64],
+        left_sole: NDArray[np.float64],
+        right_sole: NDArray[np.float64],
+        angular_momentum: NDArray[np.float64] | None,
+    ) -> None:
+        self.foot_tasks["left"].T_world_frame = left_sole
+        self.foot_tasks["right"].T_world_frame = right_sole
+        self.com_task.target_world = np.array(
+            [com_xy[0], com_xy[1], self.com_z_target(left_sole, right_sole)]
+        )
+        yaw = _mean_yaw(left_sole, right_sole)
+        self.trunk_task.R_world_frame = yaw_rotation(yaw)
+        self.pelvis_task.R_world_frame = yaw_rotation(yaw)
+        if self.momentum_task is not None:
+            target = np.zeros(3) if angular_momentum is None else angular_momentum
+            self.momentum_task.L_world = np.array([target[0], target[1], 0.0])
+
+    def com_z_target(
+        self, left_sole: NDArray[np.float64], right_sole: NDArray[np.float64]
+    ) -> float:
+        """CoM height target [m]: nominal height above the lower sole."""
+        return min(left_sole[2, 3], right_sole[2, 3]) + self.description.com_height
+
+    def solve(
+        self,
+        com_xy: NDArray[np.float64],
+        left_sole: NDArray[np.float64],
+        right_sole: NDArray[np.float64],
+        support: Support,
+        dt: float,
+        angular_momentum: NDArray[np.float64] | None = None,
+    ) -> NDArray[np.float64]:
+        """One IK step toward the targets.
+
+        Args:
+            com_xy: Horizontal CoM target in the world [m], shape (2,).
+            left_sole: Left sole pose, 4x4 homogeneous [m].
+            right_sole: Right sole pose, 4x4 homogeneous [m].
+            support: Feet on the ground (their tasks are hard).
+            dt: Time since the previous solve [s] (for the momentum task).
+            angular_momentum: Centroidal angular momentum target [N m s], shape (2,)
+                or (3,), used when the momentum task is enabled.
+
+        Returns:
+            Joint angles [rad] in :attr:`joint_names` order.
+        """
+        if support not in ("left", "right", "both"):
+            raise ParameterError("support", support, "'left', 'right' or 'both'")
+        self._configure_support(support)
+        self.solver.dt = dt
+        self._set_targets(com_xy, left_sole, right_sole, angular_momentum)
+        self.solver.solve(True)
+        self.robot.update_kinematics()
+        return self.joint_angles()
+
+    def joint_angles(self) -> NDArray[np.float64]:
+        """Current IK joint angles [rad] in :attr:`joint_names` order."""
+        return np.array([self.robot.get_joint(name) for name in self.joint_names])
+
+    def com_world(self) -> NDArray[np.float64]:
+        """CoM of the IK model in the world [m], shape (3,)."""
+        return np.asarray(self.robot.com_world(), dtype=float)
+
+    def sole_world(self, foot: str) -> NDArray[np.float64]:
+        """Pose 4x4 of the IK model's ``foot`` sole in the world [m]."""
+        return np.asarray(self.robot.get_T_world_frame(FOOT_FRAMES[foot]), dtype=float)
+
+
+def _mean_yaw(left_sole: NDArray[np.float64], right_sole: NDArray[np.float64]) -> float:
+    """Yaw [rad] of the mean of the two soles' x axes."""
+    axis = left_sole[:3, 0] + right_sole[:3, 0]
+    return float(np.arctan2(axis[1], axis[0]))

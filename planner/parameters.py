@@ -1,0 +1,269 @@
+"""Parameters of the reactive step generator, validated when built.
+
+Defaults are the paper's Section VI values where the paper gives them. The paper
+gives no mass, CoM height, foot size or bounds for its robot (MAHRU-R, an adult-size
+humanoid of about 1.5 m); the defaults below are documented choices for a robot of
+that class:
+
+- mass m = 60 kg, CoM height c_z = 0.8 m;
+- ZMP window W (6): x in [-0.08, 0.12] m, y in [-0.07, 0.07] m around the ankle,
+  inside a 0.26 m x 0.16 m foot whose ankle sits 0.09 m from the heel;
+- feedback rate of change of angular momentum |hdot| <= 20 N m per axis (arms and
+  trunk of a 60 kg robot; an effective ZMP shift of 3.4 cm). The double-support
+  compensation term m g H^-1 r~_H of Section V-B is added after this saturation
+  (see :mod:`planner.step_generator`);
+- step bounds u_d: x in [-0.4, 0.6] m, y in [-0.6, 0.6] m.
+
+With these values and gamma_v = 0.0015, the paper's Fig. 6 behaviour holds: the
+first push drives V_u to about 2.4 gamma_v (adjusted step), the second to about
+0.9 gamma_v (no adjusted step).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from .exceptions import ParameterError
+
+GRAVITY = 9.81  # [m/s^2]
+
+
+def _check_positive(owner: object, *names: str) -> None:
+    for name in names:
+        value = getattr(owner, name)
+        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0.0):
+            raise ParameterError(name, value, "a finite number > 0")
+
+
+def _check_range(name: str, value: float, low: float, high: float) -> None:
+    if not (math.isfinite(value) and low <= value <= high):
+        raise ParameterError(name, value, f"a number in [{low}, {high}]")
+
+
+def _check_finite(owner: object) -> None:
+    for f in fields(owner):  # type: ignore[arg-type]
+        value = getattr(owner, f.name)
+        if isinstance(value, bool):
+            continue
+        if isinstance(value, int | float) and not math.isfinite(value):
+            raise ParameterError(f.name, value, "a finite number")
+
+
+@dataclass(frozen=True)
+class LipmModel:
+    """Linear inverted pendulum (1).
+
+    Attributes:
+        mass: Total mass m [kg].
+        com_height: Constant CoM height c_z [m].
+        gravity: Gravitational acceleration g [m/s^2].
+    """
+
+    mass: float = 60.0
+    com_height: float = 0.8
+    gravity: float = GRAVITY
+
+    def __post_init__(self) -> None:
+        _check_positive(self, "mass", "com_height", "gravity")
+        _check_range("com_height", self.com_height, 0.05, 5.0)
+
+    @property
+    def omega(self) -> float:
+        """Natural frequency omega = sqrt(g / c_z) [1/s]."""
+        return math.sqrt(self.gravity / self.com_height)
+
+
+@dataclass(frozen=True)
+class GaitParameters:
+    """Nominal gait of the reference model (3).
+
+    Attributes:
+        stride_length: L_x^*, forward distance between successive steps [m].
+        step_width: L_y^*, lateral distance between the feet [m].
+        double_support_duration: T_DSP^* [s].
+        single_support_duration: T_SSP^* [s].
+    """
+
+    stride_length: float = 0.2
+    step_width: float = 0.2
+    double_support_duration: float = 0.1
+    single_support_duration: float = 0.7
+
+    def __post_init__(self) -> None:
+        _check_finite(self)
+        _check_range("stride_length", self.stride_length, -1.0, 1.0)
+        _check_positive(self, "step_width", "double_support_duration", "single_support_duration")
+
+    @property
+    def step_duration(self) -> float:
+        """Nominal walking cycle T^* = T_DSP^* + T_SSP^* [s]."""
+        return self.double_support_duration + self.single_support_duration
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """State and input constraints (8), (12).
+
+    Attributes:
+        zmp_window_min: w_H^m, lower corner of the ZMP window around r_H [m].
+        zmp_window_max: w_H^M, upper corner [m]; w_y = zmp_window_max[1] and the
+            window must be symmetric in y (w_y^m = -w_y^M).
+        angular_momentum_rate_max: Bound on |hdot| per axis [N m].
+        step_min: u_d^m, lower bound of the step u_d = o_H^+ - o_H [m].
+        step_max: u_d^M, upper bound of the step [m].
+    """
+
+    zmp_window_min: tuple[float, float] = (-0.08, -0.07)
+    zmp_window_max: tuple[float, float] = (0.12, 0.07)
+    angular_momentum_rate_max: float = 20.0
+    step_min: tuple[float, float] = (-0.4, -0.6)
+    step_max: tuple[float, float] = (0.6, 0.6)
+
+    def __post_init__(self) -> None:
+        for name in ("zmp_window_min", "zmp_window_max", "step_min", "step_max"):
+            value = getattr(self, name)
+            if len(value) != 2 or not all(math.isfinite(v) for v in value):
+                raise ParameterError(name, value, "two finite numbers (x, y) [m]")
+        lo, hi = self.zmp_window_min, self.zmp_window_max
+        if not (lo[0] < 0.0 < hi[0]):
+            raise ParameterError("zmp_window_min/zmp_window_max x", (lo[0], hi[0]), "min < 0 < max")
+        if not (hi[1] > 0.0 and abs(lo[1] + hi[1]) < 1e-12):
+            raise ParameterError(
+                "zmp_window_min/zmp_window_max y", (lo[1], hi[1]), "symmetric: min = -max < 0"
+            )
+        _check_positive(self, "angular_momentum_rate_max")
+        if not (self.step_min[0] < 0.0 < self.step_max[0]):
+            raise ParameterError(
+                "step_min/step_max x", (self.step_min[0], self.step_max[0]), "min < 0 < max"
+            )
+        if not (self.step_min[1] < 0.0 < self.step_max[1]):
+            raise ParameterError(
+                "step_min/step_max y", (self.step_min[1], self.step_max[1]), "min < 0 < max"
+            )
+
+    @property
+    def half_width(self) -> float:
+        """w_y, half-width of the ZMP window [m]."""
+        return self.zmp_window_max[1]
+
+    def input_min(self) -> np.ndarray:
+        """u_c^m = (p~^m, hdot^m), shape (4,)."""
+        h = self.angular_momentum_rate_max
+        return np.array([*self.zmp_window_min, -h, -h])
+
+    def input_max(self) -> np.ndarray:
+        """u_c^M = (p~^M, hdot^M), shape (4,)."""
+        h = self.angular_momentum_rate_max
+        return np.array([*self.zmp_window_max, h, h])
+
+
+@dataclass(frozen=True)
+class RsgParameters:
+    """Design parameters of the hybrid tracking controller (Section V, VI).
+
+    Attributes:
+        filter_time_constant: theta, time constant of the low-pass filter on u_c [s].
+        lyapunov_threshold: gamma_v of (21).
+        step_decrease_margin: mu_1 of (25), (26).
+        crossing_margin: mu_2 of (27b) [m].
+        com_margin: mu_3 of (27c) [m].
+        swing_preparation_time: T_SP, time the swing foot needs after the DSP before
+            it can land [s].
+        lqr_dcm_error_scale: e_max of Bryson's rule Q = I / e_max^2 [m].
+        lqr_zmp_scale: p~ scale of R, R_p = 1 / p_max^2 [m].
+        lqr_angular_momentum_scale: hdot scale of R, R_h = 1 / h_max^2 [N m].
+    """
+
+    filter_time_constant: float = 0.05
+    lyapunov_threshold: float = 0.0015
+    step_decrease_margin: float = 0.003
+    crossing_margin: float = 0.05
+    com_margin: float = 0.0001
+    swing_preparation_time: float = 0.2
+    lqr_dcm_error_scale: float = 0.05
+    lqr_zmp_scale: float = 0.05
+    lqr_angular_momentum_scale: float = 20.0
+
+    def __post_init__(self) -> None:
+        _check_positive(
+            self,
+            "filter_time_constant",
+            "lyapunov_threshold",
+            "step_decrease_margin",
+            "crossing_margin",
+            "com_margin",
+            "swing_preparation_time",
+            "lqr_dcm_error_scale",
+            "lqr_zmp_scale",
+            "lqr_angular_momentum_scale",
+        )
+
+
+CONTROLLERS = ("rsg", "fixed-timing", "no-step")
+
+
+@dataclass(frozen=True)
+class PlannerConfig:
+    """Everything the reactive step generator needs.
+
+    Attributes:
+        model: The LIPM.
+        gait: The nominal gait.
+        constraints: State and input constraints.
+        rsg: Controller design parameters.
+        controller: ``"rsg"`` (step time and location adjusted), ``"fixed-timing"``
+            (location from the QP, steps only at the nominal time, D_S alone) or
+            ``"no-step"`` (nominal steps; feedback only through ZMP and hdot).
+    """
+
+    model: LipmModel = field(default_factory=LipmModel)
+    gait: GaitParameters = field(default_factory=GaitParameters)
+    constraints: Constraints = field(default_factory=Constraints)
+    rsg: RsgParameters = field(default_factory=RsgParameters)
+    controller: str = "rsg"
+
+    def __post_init__(self) -> None:
+        if self.controller not in CONTROLLERS:
+            raise ParameterError("controller", self.controller, f"one of {', '.join(CONTROLLERS)}")
+        w_y = self.constraints.half_width
+        min_width = 2.0 * w_y + self.rsg.crossing_margin
+        if self.gait.step_width < min_width:
+            raise ParameterError(
+                "step_width",
+                self.gait.step_width,
+                f">= 2 w_y + mu_2 = {min_width:.3f} m so the nominal gait meets (27b)",
+            )
+        if self.constraints.step_max[1] < min_width:
+            raise ParameterError(
+                "step_max y",
+                self.constraints.step_max[1],
+                f">= 2 w_y + mu_2 = {min_width:.3f} m so the QP (27) can be feasible",
+            )
+        if self.gait.step_width > self.constraints.step_max[1]:
+            raise ParameterError(
+                "step_width",
+                self.gait.step_width,
+                f"<= step_max y = {self.constraints.step_max[1]} m",
+            )
+        if not (
+            self.constraints.step_min[0] <= self.gait.stride_length <= self.constraints.step_max[0]
+        ):
+            raise ParameterError(
+                "stride_length",
+                self.gait.stride_length,
+                f"within the step bounds [{self.constraints.step_min[0]}, "
+                f"{self.constraints.step_max[0]}] m",
+            )
+
+    @property
+    def adjusts_timing(self) -> bool:
+        """Whether D_T (step-time adjustment) is active."""
+        return self.controller == "rsg"
+
+    @property
+    def adjusts_location(self) -> bool:
+        """Whether the QP (27) chooses the step location when V_u >= gamma_v."""
+        return self.controller in ("rsg", "fixed-timing")

@@ -1,0 +1,251 @@
+"""The reactive step generator: the hybrid tracking controller (17) of Section V-B.
+
+State nu = (zeta, o_H, r_H^dagger, s~, V_u^dagger):
+
+- flow  F_nu = ((u^_c* - zeta) / theta, 0, 0, 1, 0),
+        u^_c* = sat(K_u e_u + (0, m g H^-1 r~_H)),
+- jump  G_nu = (zeta, o_H + u_d, r_H, 0, V_u(e_u - u_d + 2 xi1*)),
+- output H_nu = (zeta, u_d^QP) if V_u >= gamma_v else (zeta, 2 xi1*),
+
+with r~_H = -(o_H - r_H^dagger)(T_DSP - s~)/T_DSP in the DSP and 0 after it, and the
+jump set D = D_T U D_S (14):
+
+- D_S = {sign(xi2y*) xi1y* >= L_y/2} (the reference reaches its nominal jump),
+- D_T = {s~ >= T_DSP + T_SP} n (D_T,1 U D_T,2),
+  D_T,1 = {V_u >= gamma_v and V_u - V_u^dagger >= -gamma_v + mu_1},
+  D_T,2 = {sigma xi1y - w_y >= 0} (the CoM crosses the outer edge of the stance
+  foot; sign convention as in :mod:`planner.step_qp`).
+
+Two departures from the paper, both documented in the README:
+
+- The double-support compensation m g H^-1 r~_H is added to hdot after the
+  saturation of K_u e_u, not inside it. With a realistic bound on hdot the paper's
+  form saturates in every DSP of nominal walking (the term needs m g |r~_H|, about
+  165 N m for a 0.2 m x 0.2 m step at 60 kg), and the nominal gait alone would
+  leave {V_u <= gamma_v}. In the DSP, (1) with this term is the LIPM with its
+  effective ZMP at o_H + p~_H, inside the new foot's window, which the two feet on
+  the ground realise; constraint checks apply the hdot bound to the feedback part.
+- D_S is also gated by s~ >= T_DSP + T_SP. Without a push
+D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
+early step the reference may reach D_S sooner, before a real swing foot could land.
+
+Controllers in the same framework (``PlannerConfig.controller``):
+
+- ``rsg``: all of the above;
+- ``fixed-timing``: D_S alone, locations from the QP when V_u >= gamma_v;
+- ``no-step``: D_S alone and u_d = 2 xi1* always (nominal step times and
+  locations); feedback only through the ZMP and the angular momentum.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .hybrid_lipm import H_INVERSE, dcm, flow_autonomous
+from .lyapunov import LyapunovDesign, design_lyapunov
+from .parameters import PlannerConfig
+from .reference_model import NominalOrbit, ReferenceModel
+from .step_qp import build_step_qp, solve_step_qp
+from .types import Foot, Foothold, MeasuredState, PlannerOutput, StepEvent, sigma_of
+
+
+def _foot_of(sigma: int) -> Foot:
+    return "left" if sigma > 0 else "right"
+
+
+class ReactiveStepGenerator:
+    """Hybrid tracking controller (17) with the reference model (13).
+
+    Args:
+        config: Parameters; ``config.controller`` selects the variant.
+        qp_solver: Solver for the QP (27) at a step: ``"proxqp"`` or ``"exact"``.
+    """
+
+    def __init__(self, config: PlannerConfig, qp_solver: str = "proxqp") -> None:
+        self.config = config
+        self.qp_solver = qp_solver
+        self.model = config.model
+        self.omega = config.model.omega
+        self.design: LyapunovDesign = design_lyapunov(config.model, config.constraints, config.rsg)
+        self.orbit = NominalOrbit(self.omega, config.gait)
+        self._input_min = config.constraints.input_min()
+        self._input_max = config.constraints.input_max()
+        self._filter_gain = 0.0
+        self._filter_period = -1.0
+        self.reference = ReferenceModel(self.orbit, 1)
+        self.reset(Foothold("left", np.zeros(2)), Foothold("right", np.zeros(2)))
+
+    # ------------------------------------------------------------------ setup
+    def reset(
+        self, stance: Foothold, previous: Foothold, time_since_step: float | None = None
+    ) -> None:
+        """Start on the nominal orbit with ``stance`` just stepped on.
+
+        Args:
+            stance: Current stance foot o_H and sigma.
+            previous: The other foot (r_H^dagger, the window start in the DSP).
+            time_since_step: s~ at the start [s]; default T_DSP (start of the SSP).
+        """
+        gait = self.config.gait
+        s0 = gait.double_support_duration if time_since_step is None else time_since_step
+        self.sigma = sigma_of(stance.foot)
+        self.stance = np.asarray(stance.position, dtype=float).copy()
+        self.previous = np.asarray(previous.position, dtype=float).copy()
+        self.window_start = self.previous.copy()  # r_H^dagger
+        self.time_since_step = float(s0)  # s~
+        self.lyapunov_at_step = 0.0  # V_u^dagger
+        self.filter_state = np.zeros(4)  # zeta = filtered sat(K_u e_u) = (p~, hdot_fb)
+        self.compensation_state = np.zeros(2)  # filtered m g H^-1 r~_H [N m]
+        self.reference = ReferenceModel(self.orbit, self.sigma, s0)
+
+    def initial_com_state(self) -> tuple[np.ndarray, np.ndarray]:
+        """CoM position and velocity [m], [m/s] of the reference at the current state."""
+        return self.stance + self.reference.xi1, self.reference.xi2.copy()
+
+    # -------------------------------------------------------------- helpers
+    def window_offset(self) -> np.ndarray:
+        """r~_H = r_H - o_H [m]: non-zero only in the DSP."""
+        t_dsp = self.config.gait.double_support_duration
+        s = self.time_since_step
+        if s >= t_dsp:
+            return np.zeros(2)
+        return -(self.stance - self.window_start) * (t_dsp - s) / t_dsp
+
+    def dcm_error(self, xi: np.ndarray) -> np.ndarray:
+        """e_u (18) [m]."""
+        return dcm(self.omega, xi) - self.reference.dcm()
+
+    def _ready_to_step(self) -> bool:
+        gait, rsg = self.config.gait, self.config.rsg
+        return self.time_since_step >= gait.double_support_duration + rsg.swing_preparation_time
+
+    def _timing_jump(self, xi1: np.ndarray, level: float) -> bool:
+        """D_T: the step time is adjusted (only for ``rsg``)."""
+        if not self.config.adjusts_timing or not self._ready_to_step():
+            return False
+        gamma, mu1 = self.design.threshold, self.config.rsg.step_decrease_margin
+        d_t1 = level >= gamma and level - self.lyapunov_at_step >= -gamma + mu1
+        d_t2 = self.sigma * xi1[1] - self.config.constraints.half_width >= 0.0
+        return bool(d_t1 or d_t2)
+
+    def _step_location(
+        self, xi1: np.ndarray, error: np.ndarray, level: float, solver: str
+    ) -> tuple[np.ndarray, bool, bool]:
+        """u_d of the output map H_nu; returns (u_d, from_qp, qp_feasible)."""
+        if self.config.adjusts_location and level >= self.design.threshold:
+            problem = build_step_qp(
+                self.design.matrix,
+                error,
+                xi1,
+                self.reference.xi1,
+                self.sigma,
+                self.config.constraints,
+                self.config.rsg,
+            )
+            solution = solve_step_qp(problem, solver)
+            return solution.step, True, solution.feasible
+        return self.reference.nominal_step(), False, True
+
+    def preview_step(self, xi: np.ndarray) -> np.ndarray:
+        """Where the next step would land [m], re-planned at each tick.
+
+        With V_u >= gamma_v it is the QP (27) at the current state; otherwise the
+        nominal step 2 xi1* at the reference's next nominal jump.
+        """
+        error = self.dcm_error(xi)
+        level = self.design.level(error)
+        if self.config.adjusts_location and level >= self.design.threshold:
+            step, _, _ = self._step_location(xi[:2], error, level, "exact")
+            return self.stance + step
+        gait, rsg = self.config.gait, self.config.rsg
+        wait = max(
+            self.reference.time_to_nominal_jump(),
+            gait.double_support_duration + rsg.swing_preparation_time - self.time_since_step,
+        )
+        if not math.isfinite(wait):
+            wait = 0.0
+        future = flow_autonomous(self.omega, self.reference.state, wait)
+        return self.stance + 2.0 * future[:2]
+
+    # ------------------------------------------------------------ one tick
+    def update(self, measured: MeasuredState, period: float) -> PlannerOutput:
+        """Run one control tick: jump if (chi, eta) is in D, then flow for ``period``.
+
+        Args:
+            measured: CoM position and velocity at this tick.
+            period: Control period [s] over which the output is applied.
+
+        Returns:
+            The command for the next ``period`` and what the planner knows now.
+        """
+        com = np.asarray(measured.com_position, dtype=float)
+        xi = np.concatenate([com - self.stance, np.asarray(measured.com_velocity, dtype=float)])
+        error = self.dcm_error(xi)
+        level = self.design.level(error)
+
+        step_event: StepEvent | None = None
+        qp_infeasible = False
+        timing = self._timing_jump(xi[:2], level)
+        nominal = self._ready_to_step() and self.reference.in_nominal_jump_set()
+        if timing or nominal:
+            u_d, from_qp, feasible = self._step_location(xi[:2], error, level, self.qp_solver)
+            qp_infeasible = not feasible
+            window_now = self.stance + self.window_offset()
+            self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)
+            self.previous = self.stance.copy()
+            self.stance = self.stance + u_d
+            self.sigma = -self.sigma
+            self.window_start = window_now
+            self.time_since_step = 0.0
+            self.reference.jump()
+            step_event = StepEvent(
+                time=measured.time,
+                foot=_foot_of(self.sigma),
+                position=self.stance.copy(),
+                timing_adjusted=bool(timing and not nominal),
+                location_adjusted=from_qp,
+                lyapunov_before=level,
+                lyapunov_after=self.lyapunov_at_step,
+            )
+            xi = np.concatenate([com - self.stance, xi[2:]])
+            error = self.dcm_error(xi)
+            level = self.design.level(error)
+
+        window_offset = self.window_offset()
+        zmp_offset = self.filter_state[:2].copy()
+        angular_momentum_rate = self.filter_state[2:] + self.compensation_state
+        output = PlannerOutput(
+            time=measured.time,
+            zmp=self.stance + zmp_offset + window_offset,
+            zmp_offset=zmp_offset,
+            window_center=self.stance + window_offset,
+            angular_momentum_rate=angular_momentum_rate,
+            angular_momentum_rate_feedback=self.filter_state[2:].copy(),
+            stance=Foothold(_foot_of(self.sigma), self.stance.copy()),
+            previous_stance=Foothold(_foot_of(-self.sigma), self.previous.copy()),
+            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi)),
+            time_since_step=self.time_since_step,
+            double_support=self.time_since_step < self.config.gait.double_support_duration,
+            dcm_error=error,
+            lyapunov=level,
+            lyapunov_at_step=self.lyapunov_at_step,
+            com_reference=self.stance + self.reference.xi1,
+            step=step_event,
+            qp_infeasible=qp_infeasible,
+        )
+        self._flow(error, window_offset, period)
+        return output
+
+    def _flow(self, error: np.ndarray, window_offset: np.ndarray, period: float) -> None:
+        """Flow of nu and of the reference model over ``period`` [s]."""
+        compensation = self.model.mass * self.model.gravity * (H_INVERSE @ window_offset)
+        target = np.clip(self.design.gain @ error, self._input_min, self._input_max)
+        if period != self._filter_period:
+            self._filter_period = period
+            self._filter_gain = 1.0 - math.exp(-period / self.config.rsg.filter_time_constant)
+        self.filter_state += self._filter_gain * (target - self.filter_state)
+        self.compensation_state += self._filter_gain * (compensation - self.compensation_state)
+        self.time_since_step += period
+        self.reference.flow(period)

@@ -1,0 +1,239 @@
+"""The discrete controller: the step-location QP (27).
+
+    minimize_{u_d}  V_u(e_u^+),  e_u^+ = e_u - u_d + 2 xi1*                  (27a)
+    subject to      sigma+ u_d,y >= 2 w_y + mu_2          (no crossing)       (27b)
+                    sigma+ xi1,y^+ <= w_y - mu_3           (CoM inside feet)   (27c)
+                    u_d^m <= u_d <= u_d^M                  (step bounds)       (27d)
+
+with sigma+ = -sigma the new stance foot and xi1^+ = xi1 - u_d.
+
+Sign convention: we keep the paper's text definition sigma = +1 for the left stance
+foot with y to the left. The printed (12b), (27b), (27c) and D_T,2 carry the opposite
+sign of sigma (they hold as printed for sigma = +1 on the right foot); written as
+above they say what Section III-B states in words: the new foot lands at least
+2 w_y + mu_2 on its own side of the old one, and the CoM stays inside the outer edge
+of the new stance foot.
+
+Infeasibility: (27b)-(27d) reduce to a box on u_d. (27c) can make it empty when the
+CoM is already beyond where the largest lateral step can reach. The documented
+fallback is then to drop (27c) and take the step that minimises V_u within (27b),
+(27d): the largest step the robot can make towards the DCM. The solution reports
+``feasible=False`` and the run counts it in ``qp_infeasible``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import qpsolvers
+
+from .exceptions import StepQpError
+from .parameters import Constraints, RsgParameters
+
+
+@dataclass(frozen=True)
+class StepQpProblem:
+    """Data of the QP (27) in the form min (d - u)^T P (d - u) s.t. G u <= h.
+
+    Attributes:
+        lyapunov_matrix: P_u (2x2).
+        target: d = e_u + 2 xi1*, the step that zeroes e_u^+ [m].
+        inequality_matrix: G (k x 2) of (27b), (27c) (and (27d) as rows).
+        inequality_vector: h (k,).
+        lower: Lower bound of u_d (27d) [m].
+        upper: Upper bound of u_d (27d) [m].
+        com_row: Index of the (27c) row in G, h.
+    """
+
+    lyapunov_matrix: np.ndarray
+    target: np.ndarray
+    inequality_matrix: np.ndarray
+    inequality_vector: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+    com_row: int = 1
+
+    def objective(self, step: np.ndarray) -> float:
+        """V_u(e_u^+) for the step u_d."""
+        diff = self.target - np.asarray(step, dtype=float)
+        return float(diff @ self.lyapunov_matrix @ diff)
+
+    def max_violation(self, step: np.ndarray, with_com: bool = True) -> float:
+        """Largest violation of (27b)-(27d) by ``step`` [m] (<= 0 when feasible)."""
+        step = np.asarray(step, dtype=float)
+        rows = self.inequality_matrix @ step - self.inequality_vector
+        if not with_com:
+            rows = np.delete(rows, self.com_row)
+        return float(max(rows.max(), (self.lower - step).max(), (step - self.upper).max()))
+
+    def without_com_constraint(self) -> StepQpProblem:
+        """The same problem without (27c): the fallback."""
+        keep = [i for i in range(len(self.inequality_vector)) if i != self.com_row]
+        return StepQpProblem(
+            self.lyapunov_matrix,
+            self.target,
+            self.inequality_matrix[keep],
+            self.inequality_vector[keep],
+            self.lower,
+            self.upper,
+            com_row=-1,
+        )
+
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """The feasible set as a box [lo, hi] (it is one: (27b), (27c) bound u_d,y only)."""
+        lo, hi = self.lower.copy(), self.upper.copy()
+        for row, bound in zip(self.inequality_matrix, self.inequality_vector, strict=True):
+            axes = np.flatnonzero(row)
+            if len(axes) != 1:
+                raise StepQpError("a constraint couples x and y: not a box", self)
+            axis = int(axes[0])
+            if row[axis] > 0.0:
+                hi[axis] = min(hi[axis], bound / row[axis])
+            else:
+                lo[axis] = max(lo[axis], bound / row[axis])
+        return lo, hi
+
+
+@dataclass(frozen=True)
+class StepQpSolution:
+    """Solution of (27).
+
+    Attributes:
+        step: u_d [m].
+        lyapunov_after: V_u(e_u^+).
+        feasible: False when (27c) had to be dropped (fallback).
+    """
+
+    step: np.ndarray
+    lyapunov_after: float
+    feasible: bool
+
+
+def build_step_qp(
+    lyapunov_matrix: np.ndarray,
+    dcm_error: np.ndarray,
+    xi1: np.ndarray,
+    xi1_reference: np.ndarray,
+    sigma: int,
+    constraints: Constraints,
+    params: RsgParameters,
+) -> StepQpProblem:
+    """Problem (27) at the current state.
+
+    Args:
+        lyapunov_matrix: P_u.
+        dcm_error: e_u before the step [m].
+        xi1: c_H - o_H before the step [m].
+        xi1_reference: xi1* before the step [m].
+        sigma: Current stance foot (+1 left, -1 right); the new one is -sigma.
+        constraints: Bounds w_y, u_d^m, u_d^M.
+        params: Margins mu_2, mu_3.
+    """
+    sigma_new = -sigma
+    w_y = constraints.half_width
+    g = np.array(
+        [
+            [0.0, -sigma_new],  # (27b): -sigma+ u_y <= -(2 w_y + mu_2)
+            [0.0, -sigma_new],  # (27c): -sigma+ u_y <= w_y - mu_3 - sigma+ xi1_y
+        ]
+    )
+    h = np.array(
+        [
+            -(2.0 * w_y + params.crossing_margin),
+            w_y - params.com_margin - sigma_new * float(xi1[1]),
+        ]
+    )
+    return StepQpProblem(
+        lyapunov_matrix=np.asarray(lyapunov_matrix, dtype=float),
+        target=np.asarray(dcm_error, dtype=float) + 2.0 * np.asarray(xi1_reference, dtype=float),
+        inequality_matrix=g,
+        inequality_vector=h,
+        lower=np.array(constraints.step_min, dtype=float),
+        upper=np.array(constraints.step_max, dtype=float),
+        com_row=1,
+    )
+
+
+def _is_feasible(problem: StepQpProblem) -> bool:
+    lo, hi = problem.box()
+    return bool(np.all(lo <= hi + 1e-12))
+
+
+def solve_with_qpsolvers(problem: StepQpProblem, solver: str = "proxqp") -> np.ndarray | None:
+    """Solve min (d-u)^T P (d-u) s.t. G u <= h, lb <= u <= ub with qpsolvers.
+
+    Returns:
+        u_d, or None if the solver reports no solution.
+    """
+    p = 2.0 * problem.lyapunov_matrix
+    q = -2.0 * problem.lyapunov_matrix @ problem.target
+    try:
+        x = qpsolvers.solve_qp(
+            p,
+            q,
+            G=problem.inequality_matrix,
+            h=problem.inequality_vector,
+            lb=problem.lower,
+            ub=problem.upper,
+            solver=solver,
+            eps_abs=1e-9,
+            eps_rel=0.0,
+        )
+    except (qpsolvers.SolverError, ValueError) as exc:
+        raise StepQpError(f"qpsolvers/{solver} failed: {exc}", problem) from exc
+    return None if x is None else np.asarray(x, dtype=float)
+
+
+def solve_box_exact(problem: StepQpProblem) -> np.ndarray | None:
+    """Exact minimiser of the 2-variable convex QP over its box (no iterations).
+
+    The minimum of a convex quadratic over a box is the unconstrained minimum if it
+    lies inside, and otherwise lies on an edge, where it is a clipped 1-D minimum.
+
+    Returns:
+        u_d, or None if the box is empty.
+    """
+    lo, hi = problem.box()
+    if np.any(lo > hi + 1e-12):
+        return None
+    hi = np.maximum(hi, lo)
+    d, p = problem.target, problem.lyapunov_matrix
+    if np.all(d >= lo) and np.all(d <= hi):
+        return d.copy()
+    best, best_value = None, np.inf
+    for axis in (0, 1):
+        other = 1 - axis
+        for fixed in (lo[axis], hi[axis]):
+            # Minimise over u_other with u_axis = fixed.
+            u = np.empty(2)
+            u[axis] = fixed
+            # d/du_o of (d-u)^T P (d-u) = 0 -> u_o = d_o + P_ao (d_a - fixed) / P_oo
+            u[other] = d[other] + p[axis, other] * (d[axis] - fixed) / p[other, other]
+            u[other] = np.clip(u[other], lo[other], hi[other])
+            value = problem.objective(u)
+            if value < best_value:
+                best, best_value = u, value
+    return best
+
+
+def solve_step_qp(problem: StepQpProblem, solver: str = "proxqp") -> StepQpSolution:
+    """Solve (27), falling back to the problem without (27c) when it is infeasible.
+
+    Args:
+        problem: The QP.
+        solver: ``"proxqp"`` (qpsolvers backend) or ``"exact"`` (box method).
+
+    Raises:
+        StepQpError: If even the fallback problem cannot be solved (the bounds are
+            inconsistent; :class:`~planner.parameters.PlannerConfig` prevents that).
+    """
+    feasible = _is_feasible(problem)
+    to_solve = problem if feasible else problem.without_com_constraint()
+    if solver == "exact":
+        step = solve_box_exact(to_solve)
+    else:
+        step = solve_with_qpsolvers(to_solve, solver)
+    if step is None:
+        raise StepQpError("the step QP (27) without (27c) has no solution", to_solve)
+    return StepQpSolution(step=step, lyapunov_after=problem.objective(step), feasible=feasible)

@@ -1,0 +1,153 @@
+"""What the full-robot side needs to know about one biped.
+
+A :class:`RobotDescription` gathers every robot-specific constant (URDF source,
+link names, sole geometry, nominal posture, joint gains, fall thresholds) so that
+the whole-body IK and the PyBullet backend stay robot-agnostic. Frames: the sole
+frame of a foot has its origin on the ground below the ankle, x forward, z up.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from types import MappingProxyType
+
+from planner.exceptions import ParameterError
+
+
+@dataclass(frozen=True)
+class JointGains:
+    """PyBullet POSITION_CONTROL parameters of one joint.
+
+    Attributes:
+        position_gain: PyBullet ``positionGain`` kp [1/s-ish, PyBullet's velocity
+            constraint scaling], in (0, 1].
+        velocity_gain: PyBullet ``velocityGain`` kd [-], in [0, 1.5].
+        max_force: Maximum joint torque the motor may apply [N m], > 0.
+    """
+
+    position_gain: float
+    velocity_gain: float
+    max_force: float
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.position_gain <= 1.0:
+            raise ParameterError("position_gain", self.position_gain, "0 < kp <= 1")
+        if not 0.0 <= self.velocity_gain <= 1.5:
+            raise ParameterError("velocity_gain", self.velocity_gain, "0 <= kd <= 1.5")
+        if not self.max_force > 0.0:
+            raise ParameterError("max_force", self.max_force, "> 0 N m")
+
+
+@dataclass(frozen=True)
+class SoleRectangle:
+    """Contact rectangle of a sole, in the sole frame.
+
+    Attributes:
+        x_min: Rear edge [m] (negative: behind the ankle).
+        x_max: Front edge [m].
+        half_width: Half of the lateral extent, symmetric about the ankle [m].
+    """
+
+    x_min: float
+    x_max: float
+    half_width: float
+
+    def __post_init__(self) -> None:
+        if not self.x_min < 0.0 < self.x_max:
+            raise ParameterError("sole.x_min/x_max", (self.x_min, self.x_max), "x_min < 0 < x_max")
+        if not self.half_width > 0.0:
+            raise ParameterError("sole.half_width", self.half_width, "> 0 m")
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    """Robot-specific constants of a biped from example-robot-data.
+
+    Attributes:
+        name: Registry name (``"g1"``).
+        urdf_source: URDF path relative to example-robot-data's ``robots/`` share
+            folder (``"g1_description/urdf/g1_29dof_rev_1_0.urdf"``).
+        base_link: Floating-base link of the URDF (the pelvis).
+        left_ankle_link: Link carrying the left sole.
+        right_ankle_link: Link carrying the right sole.
+        trunk_link: Link whose orientation is kept upright (torso).
+        sole_offset: Position of the sole frame origin in the ankle link frame [m],
+            3 values; the sole frame has the ankle link's orientation.
+        sole: Sole contact rectangle (bounds the planner's ZMP window).
+        com_height: Nominal CoM height above the ground while walking [m].
+        foot_spacing: Nominal lateral distance between the two ankles [m].
+        standing_posture: Joint name -> angle [rad] of the nominal posture; joints
+            not listed are at 0 rad.
+        joint_gains: Joint name -> PyBullet gains; missing joints use
+            ``default_gains``.
+        default_gains: Gains of joints not in ``joint_gains``.
+        total_mass: Mass from the URDF [kg] (checked against PyBullet in the tests).
+        fall_base_height: Pelvis height [m] under which the robot counts as fallen.
+        fall_tilt: Pelvis tilt from vertical [rad] over which it counts as fallen.
+        swing_height: Apex height of the swing sole above the ground [m].
+        ground_friction: Lateral friction coefficient of the ground and soles [-].
+    """
+
+    name: str
+    urdf_source: str
+    base_link: str
+    left_ankle_link: str
+    right_ankle_link: str
+    trunk_link: str
+    sole_offset: tuple[float, float, float]
+    sole: SoleRectangle
+    com_height: float
+    foot_spacing: float
+    standing_posture: Mapping[str, float]
+    default_gains: JointGains
+    total_mass: float
+    joint_gains: Mapping[str, JointGains] = field(default_factory=dict)
+    fall_base_height: float = 0.4
+    fall_tilt: float = math.radians(45.0)
+    swing_height: float = 0.06
+    ground_friction: float = 1.0
+
+    def __post_init__(self) -> None:
+        if not self.name or not self.name.isidentifier():
+            raise ParameterError("name", self.name, "a non-empty identifier")
+        if not self.urdf_source.endswith(".urdf") or self.urdf_source.startswith("/"):
+            raise ParameterError("urdf_source", self.urdf_source, "a relative path to a .urdf")
+        links = (self.base_link, self.left_ankle_link, self.right_ankle_link, self.trunk_link)
+        if any(not link for link in links) or self.left_ankle_link == self.right_ankle_link:
+            raise ParameterError("links", links, "non-empty names, distinct ankle links")
+        if len(self.sole_offset) != 3 or not self.sole_offset[2] < 0.0:
+            raise ParameterError("sole_offset", self.sole_offset, "(x, y, z<0) [m]")
+        if not 0.2 <= self.com_height <= 2.0:
+            raise ParameterError("com_height", self.com_height, "0.2 m <= c_z <= 2 m")
+        if not 0.0 < self.foot_spacing < 1.0:
+            raise ParameterError("foot_spacing", self.foot_spacing, "0 < L_y < 1 m")
+        if not self.total_mass > 0.0:
+            raise ParameterError("total_mass", self.total_mass, "> 0 kg")
+        if not 0.0 < self.fall_base_height < 2.0:
+            raise ParameterError("fall_base_height", self.fall_base_height, "0 < h < 2 m")
+        if not 0.0 < self.fall_tilt < math.pi / 2:
+            raise ParameterError("fall_tilt", self.fall_tilt, "0 < tilt < pi/2 rad")
+        if not 0.0 < self.swing_height < 0.3:
+            raise ParameterError("swing_height", self.swing_height, "0 < h < 0.3 m")
+        if not self.ground_friction > 0.0:
+            raise ParameterError("ground_friction", self.ground_friction, "> 0")
+        for joint, angle in self.standing_posture.items():
+            if not math.isfinite(angle):
+                raise ParameterError(f"standing_posture[{joint}]", angle, "a finite angle [rad]")
+        # Freeze the mappings so the description stays immutable and hashable-safe.
+        object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
+        object.__setattr__(self, "joint_gains", MappingProxyType(dict(self.joint_gains)))
+
+    def gains_of(self, joint: str) -> JointGains:
+        """PyBullet gains of ``joint`` (its own, else the defaults)."""
+        return self.joint_gains.get(joint, self.default_gains)
+
+    def ankle_link(self, foot: str) -> str:
+        """Ankle link name of ``foot`` (``"left"`` or ``"right"``)."""
+        if foot == "left":
+            return self.left_ankle_link
+        if foot == "right":
+            return self.right_ankle_link
+        raise ParameterError("foot", foot, "'left' or 'right'")

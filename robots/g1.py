@@ -1,0 +1,79 @@
+"""Unitree G1 (29 DoF, rev 1.0) from example-robot-data.
+
+Measured facts: 33.3 kg; each foot touches the ground only through four 5 mm
+spheres centred 30 mm below ``*_ankle_roll_link`` at x in {-0.05, 0.12} m and
+y in {+-0.025, +-0.03} m (about 17 x 6 cm); four links have no ``<inertial>``
+(the IMU and camera frames), fixed in the derived URDF.
+"""
+
+from __future__ import annotations
+
+from robots.description import JointGains, RobotDescription, SoleRectangle
+
+_LEG_BEND = {"hip_pitch": -0.35, "knee": 0.7, "ankle_pitch": -0.35}
+_ARMS = {"shoulder_pitch": 0.2, "elbow": 0.9}
+_SHOULDER_ROLL = 0.2  # [rad], outward (left +, right -)
+
+STANDING_POSTURE = {
+    **{
+        f"{side}_{joint}_joint": angle
+        for side in ("left", "right")
+        for joint, angle in _LEG_BEND.items()
+    },
+    **{
+        f"{side}_{joint}_joint": angle
+        for side in ("left", "right")
+        for joint, angle in _ARMS.items()
+    },
+    "left_shoulder_roll_joint": _SHOULDER_ROLL,
+    "right_shoulder_roll_joint": -_SHOULDER_ROLL,
+}
+
+_LEG_GAINS = JointGains(position_gain=0.1, velocity_gain=1.0, max_force=139.0)
+_ANKLE_GAINS = JointGains(position_gain=0.05, velocity_gain=1.0, max_force=50.0)
+_ARM_GAINS = JointGains(position_gain=0.1, velocity_gain=1.0, max_force=25.0)
+
+JOINT_GAINS = {
+    **{
+        f"{side}_{joint}_joint": _LEG_GAINS
+        for side in ("left", "right")
+        for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee")
+    },
+    **{
+        f"{side}_{joint}_joint": _ANKLE_GAINS
+        for side in ("left", "right")
+        for joint in ("ankle_pitch", "ankle_roll")
+    },
+    **{
+        f"{side}_{joint}_joint": _ARM_GAINS
+        for side in ("left", "right")
+        for joint in (
+            "shoulder_pitch",
+            "shoulder_roll",
+            "shoulder_yaw",
+            "elbow",
+            "wrist_roll",
+            "wrist_pitch",
+            "wrist_yaw",
+        )
+    },
+}
+
+G1 = RobotDescription(
+    name="g1",
+    urdf_source="g1_description/urdf/g1_29dof_rev_1_0.urdf",
+    base_link="pelvis",
+    left_ankle_link="left_ankle_roll_link",
+    right_ankle_link="right_ankle_roll_link",
+    trunk_link="torso_link",
+    sole_offset=(0.0, 0.0, -0.035),
+    sole=SoleRectangle(x_min=-0.05, x_max=0.12, half_width=0.025),
+    com_height=0.66,
+    foot_spacing=0.23,
+    standing_posture=STANDING_POSTURE,
+    joint_gains=JOINT_GAINS,
+    default_gains=JointGains(position_gain=0.1, velocity_gain=1.0, max_force=88.0),
+    total_mass=33.3,
+    fall_base_height=0.45,
+    swing_height=0.06,
+)

@@ -1,0 +1,103 @@
+"""Whole-body IK, swing-foot trajectory and LIPM CoM plan."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinematics.com_plan import lipm_integrate
+from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
+from kinematics.whole_body_ik import WholeBodyIK, sole_pose
+from planner.exceptions import ParameterError
+from robots import get_robot
+
+DT = 0.01
+
+
+@pytest.fixture(scope="module")
+def ik():
+    return WholeBodyIK(get_robot("g1"))
+
+
+def test_ik_reaches_com_targets_with_feet_fixed(ik):
+    left, right = sole_pose([0.0, 0.115, 0.0]), sole_pose([0.0, -0.115, 0.0])
+    ik.reset(left, right, np.zeros(2))
+    assert ik.com_world()[2] == pytest.approx(get_robot("g1").com_height, abs=5e-3)
+    for target in ([0.03, 0.0], [0.0, 0.08], [-0.02, -0.06]):
+        for _ in range(30):
+            ik.solve(np.array(target), left, right, "both", DT)
+        assert np.linalg.norm(ik.com_world()[:2] - target) < 2e-3
+        assert np.linalg.norm(ik.sole_world("left")[:3, 3] - left[:3, 3]) < 1e-4
+        assert np.linalg.norm(ik.sole_world("right")[:3, 3] - right[:3, 3]) < 1e-3
+
+
+def test_ik_moves_the_swing_foot_in_single_support(ik):
+    left, right = sole_pose([0.0, 0.115, 0.0]), sole_pose([0.0, -0.115, 0.0])
+    ik.reset(left, right, np.array([0.0, 0.1]))
+    lifted = sole_pose([0.1, -0.115, 0.05])
+    for _ in range(30):
+        ik.solve(np.array([0.0, 0.1]), left, lifted, "left", DT)
+    assert np.linalg.norm(ik.sole_world("right")[:3, 3] - lifted[:3, 3]) < 5e-3
+    assert np.linalg.norm(ik.sole_world("left")[:3, 3] - left[:3, 3]) < 1e-4
+
+
+def test_ik_rejects_unknown_support(ik):
+    with pytest.raises(ParameterError):
+        ik.solve(np.zeros(2), np.eye(4), np.eye(4), "none", DT)
+
+
+TIMING = SwingTiming()
+
+
+def _swing(target_of_time, landing=None, timing=TIMING):
+    trajectory = SwingFootTrajectory(timing, apex_height=0.06)
+    trajectory.start(np.array([0.0, -0.1]))
+    positions = []
+    steps = round((landing or timing.nominal_step) / DT)
+    for k in range(1, steps + 1):
+        time = k * DT
+        positions.append(trajectory.update(time, target_of_time(time), DT, landing))
+    return np.array(positions)
+
+
+def test_swing_foot_reaches_a_moving_target_and_lands_at_the_step_time():
+    def target(time):
+        return np.array([0.2, -0.1]) if time < 0.4 else np.array([0.25, -0.05])
+
+    positions = _swing(target)
+    assert np.allclose(positions[:9, :2], [0.0, -0.1])  # still in double support
+    assert positions[:, 2].max() == pytest.approx(0.06, abs=5e-3)
+    assert np.linalg.norm(positions[-1, :2] - [0.25, -0.05]) < 1e-3
+    assert positions[-1, 2] == pytest.approx(0.0, abs=1e-9)
+    speeds = np.linalg.norm(np.diff(positions[:, :2], axis=0), axis=1) / DT
+    assert speeds.max() <= 2.0 + 1e-9
+
+
+def test_swing_foot_lands_early_when_the_planner_plans_an_early_step():
+    positions = _swing(lambda _: np.array([0.15, -0.1]), landing=0.4)
+    assert np.linalg.norm(positions[-1, :2] - [0.15, -0.1]) < 1e-3
+    assert positions[-1, 2] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_swing_height_profile():
+    assert swing_height(0.05, 0.1, 0.8, 0.06) == 0.0
+    assert swing_height(0.45, 0.1, 0.8, 0.06) == pytest.approx(0.06)
+    assert swing_height(0.8, 0.1, 0.8, 0.06) == pytest.approx(0.0)
+
+
+def test_lipm_integration_matches_the_closed_form_and_includes_the_momentum():
+    com, velocity = np.array([0.02, -0.01]), np.array([0.1, 0.05])
+    zmp = np.zeros(2)
+    position, new_velocity = lipm_integrate(com, velocity, zmp, np.zeros(2), 30.0, 0.7, 0.0)
+    assert np.allclose(position, com) and np.allclose(new_velocity, velocity)
+    # Numerical integration of c_dd = g/c_z (c - p) + S hdot / (m c_z).
+    mass, height, hdot = 30.0, 0.7, np.array([5.0, -3.0])
+    state_position, state_velocity = com.copy(), velocity.copy()
+    rotation = np.array([[0.0, -1.0], [1.0, 0.0]])
+    for _ in range(10000):
+        acceleration = 9.81 / height * (state_position - zmp) + rotation @ hdot / (mass * height)
+        state_velocity = state_velocity + 1e-5 * acceleration
+        state_position = state_position + 1e-5 * state_velocity
+    position, new_velocity = lipm_integrate(com, velocity, zmp, hdot, mass, height, 0.1)
+    assert np.allclose(position, state_position, atol=1e-6)
+    assert np.allclose(new_velocity, state_velocity, atol=1e-5)

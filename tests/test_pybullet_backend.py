@@ -1,0 +1,138 @@
+"""The PyBullet backend: masses, standing, stepping, falls, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app.backend import InitialCondition
+from app.pybullet_backend import PyBulletBackend
+from planner.types import Foothold, PlannerOutput, StepEvent
+
+LEFT = Foothold("left", np.array([0.0, 0.115]))
+RIGHT = Foothold("right", np.array([0.0, -0.115]))
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture
+def backend():
+    instance = PyBulletBackend("g1")
+    yield instance
+    instance.close()
+
+
+def command(
+    time, zmp, stance=LEFT, swing=RIGHT, next_step=None, since_step=0.0, step=None
+) -> PlannerOutput:
+    zmp = np.asarray(zmp, float)
+    return PlannerOutput(
+        time=time,
+        zmp=zmp,
+        zmp_offset=np.zeros(2),
+        window_center=zmp,
+        angular_momentum_rate=np.zeros(2),
+        angular_momentum_rate_feedback=np.zeros(2),
+        stance=stance,
+        previous_stance=swing,
+        next_step=next_step or swing,
+        time_since_step=since_step,
+        double_support=since_step < 0.1,
+        dcm_error=np.zeros(2),
+        lyapunov=0.0,
+        lyapunov_at_step=0.0,
+        com_reference=zmp,
+        step=step,
+    )
+
+
+def stand(backend, seconds, push=None, zmp=(0.0, 0.0)):
+    state = None
+    for tick in range(round(seconds / backend.control_period)):
+        time = tick * backend.control_period
+        force = push(time) if push else np.zeros(2)
+        state = backend.step(command(time, zmp), force)
+        if backend.fall_status().fell:
+            break
+    return state
+
+
+def test_mass_in_pybullet_equals_the_urdf_mass(backend):
+    assert backend.mass == pytest.approx(33.3, abs=0.1)
+    assert backend.com_height == pytest.approx(0.66)
+
+
+def test_g1_stands_still_for_5_s_with_constant_commands(backend):
+    start = backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    assert backend.feet_in_contact() == set() or backend.fall_status().fell is False
+    state = stand(backend, 5.0)
+    assert not backend.fall_status().fell
+    assert state.time == pytest.approx(5.0)
+    assert np.linalg.norm(state.com_position - start.com_position) < 0.01
+    assert np.linalg.norm(state.com_velocity) < 0.01
+    assert backend.feet_in_contact() == {"left", "right"}
+    report = backend.timing_report()
+    assert {"physics", "ik", "estimation", "planning", "total"} <= set(report)
+
+
+def test_base_configuration_is_the_urdf_pelvis_frame(backend):
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    position, quaternion, joints = backend.robot_configuration()
+    ik_base = backend.ik.robot.get_T_world_fbase()
+    assert np.allclose(position, ik_base[:3, 3], atol=1e-6)
+    assert np.isclose(abs(quaternion[3]), 1.0, atol=1e-6)
+    assert set(joints) == set(backend.ik.joint_names)
+
+
+def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+
+    def push(time):
+        return np.array([0.0, 400.0]) if 0.5 <= time < 0.6 else np.zeros(2)
+
+    stand(backend, 3.0, push)
+    status = backend.fall_status()
+    assert status.fell and status.reason
+
+
+def test_same_commands_give_the_same_result():
+    results = []
+    for _ in range(2):
+        backend = PyBulletBackend("g1", com_reference_blend=0.05, com_tracking_gains=(1.0, 0.0))
+        backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.array([0.0, 0.1])))
+        state = stand(backend, 0.5, lambda t: np.array([20.0, 0.0]), zmp=(0.0, 0.02))
+        results.append(np.concatenate([state.com_position, state.com_velocity]))
+        backend.close()
+    assert np.array_equal(results[0], results[1])
+
+
+def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
+    over_left = LEFT.position.copy()
+    backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+    steps = round(0.8 / backend.control_period)
+    for tick in range(steps):
+        time = tick * backend.control_period
+        target = np.array([0.08, -0.115]) if time < 0.3 else np.array([0.1, -0.13])
+        backend.step(
+            command(time, over_left, next_step=Foothold("right", target), since_step=time),
+            np.zeros(2),
+        )
+        assert not backend.fall_status().fell
+    landed = Foothold("right", np.array([0.1, -0.13]))
+    event = StepEvent(0.8, "right", landed.position, False, False)
+    for tick in range(20):
+        time = 0.8 + tick * backend.control_period
+        step = event if tick == 0 else None
+        zmp = over_left + (landed.position - over_left) * 0.0
+        backend.step(
+            command(time, zmp, stance=landed, swing=LEFT, since_step=time - 0.8, step=step),
+            np.zeros(2),
+        )
+    soles = backend.sole_positions()
+    assert np.linalg.norm(soles["right"][:2] - landed.position) < 0.01
+    assert abs(soles["right"][2]) < 0.005
+    assert "right" in backend.feet_in_contact()
+    assert not backend.fall_status().fell

@@ -1,0 +1,137 @@
+"""The reactive step generator in closed loop with the LIPM: the paper's claims."""
+
+import numpy as np
+import pytest
+
+from app.scenarios import BUILT_IN
+from conftest import run_lipm, scaled
+from planner.parameters import PlannerConfig
+from planner.step_generator import ReactiveStepGenerator
+from planner.types import Foothold, MeasuredState
+
+FIG6 = BUILT_IN["paper-fig6"]
+
+
+def adjusted_between(result, start, end):
+    return [s for s in result.steps if start <= s.event["t"] < end and s.event["adjusted"]]
+
+
+def test_nominal_walk_is_periodic_and_never_adjusted():
+    result = run_lipm("rsg", BUILT_IN["walk"])
+    assert result.recovered
+    assert not any(s.event["adjusted"] for s in result.steps)
+    times = np.array([s.event["t"] for s in result.steps])
+    np.testing.assert_allclose(np.diff(times), 0.8, atol=0.003)
+    steps = np.array([s.step for s in result.steps])
+    np.testing.assert_allclose(steps[:, 0], 0.2, atol=0.003)
+    np.testing.assert_allclose(np.abs(steps[:, 1]), 0.2, atol=0.003)
+    assert result.max_lyapunov < result.lyapunov_threshold
+
+
+def test_paper_fig6_with_rsg(fig6_runs):
+    """Recovered; adjusted step(s) after push 1; none after push 2; no violation."""
+    result = fig6_runs["rsg"]
+    first, second = (p.time for p in FIG6.pushes)
+    assert result.recovered, result.fall
+    assert len(adjusted_between(result, first, second)) >= 1
+    assert adjusted_between(result, second, 1e9) == []
+    assert result.constraint_violations == 0, result.violations
+    assert result.qp_infeasible == 0
+    window = result.column("t") >= second
+    assert result.column("lyapunov")[window].max() < result.lyapunov_threshold
+
+
+@pytest.mark.parametrize("factor", [3.0])
+def test_pushes_that_topple_no_step_are_recovered_by_rsg(factor):
+    scenario = scaled(FIG6, factor)
+    no_step = run_lipm("no-step", scenario)
+    rsg = run_lipm("rsg", scenario)
+    assert no_step.fall.fell, f"{factor=}: no-step should fall"
+    assert rsg.recovered, f"{factor=}: {rsg.fall}"
+    assert rsg.violations["crossing"] == 0 and rsg.violations["step_bounds"] == 0
+
+
+@pytest.mark.parametrize("factor", [1.0, 2.0, 3.0])
+def test_post_step_level_decreases_in_case_a(factor):
+    """(24): in Case (a) (previous post-step level >= gamma_v), each adjusted step
+    lowers the post-step level by at least gamma_v, until V_u < gamma_v."""
+    result = run_lipm("rsg", scaled(FIG6, factor))
+    gamma = result.lyapunov_threshold
+    previous_post = 0.0
+    checked = 0
+    for step in result.steps:
+        event = step.event
+        if event["adjusted"] and previous_post >= gamma:
+            post = event["lyapunov_after"]
+            assert post <= previous_post - gamma + 1e-9 or post < gamma, f"{factor=} {event=}"
+            checked += 1
+        previous_post = event["lyapunov_after"]
+    if factor >= 2.0:
+        assert checked >= 1, "the scenario should exercise Case (a)"
+
+
+def test_jump_19b_and_nominal_location():
+    """At each step e_u^+ = e_u - u_d + 2 xi1*; u_d = 2 xi1* when V_u < gamma_v."""
+    config = PlannerConfig()
+    gen = ReactiveStepGenerator(config)
+    gen.reset(
+        Foothold("left", np.array([0.0, 0.1])),
+        Foothold("right", np.array([-0.2, -0.1])),
+        time_since_step=0.79,
+    )
+    com, velocity = gen.initial_com_state()
+    velocity = velocity + np.array([0.004, -0.002])  # a small DCM error, V_u < gamma_v
+    xi = np.r_[com - gen.stance, velocity]
+    error_before = gen.dcm_error(xi)
+    reference_xi1 = gen.reference.xi1.copy()
+    stance_before = gen.stance.copy()
+    dt = 0.001
+    for k in range(40):
+        out = gen.update(MeasuredState(k * dt, com, velocity), dt)
+        if out.step is not None:
+            break
+        com = com + velocity * dt
+        xi = np.r_[com - gen.stance, velocity]
+        error_before, reference_xi1, stance_before = (
+            gen.dcm_error(xi),
+            gen.reference.xi1.copy(),
+            gen.stance.copy(),
+        )
+    assert out.step is not None and not out.step.adjusted
+    u_d = out.stance.position - stance_before
+    np.testing.assert_allclose(u_d, 2 * reference_xi1, atol=1e-12)
+    np.testing.assert_allclose(out.dcm_error, error_before - u_d + 2 * reference_xi1, atol=1e-9)
+
+
+def test_same_run_twice_is_identical(fig6_runs):
+    again = run_lipm("rsg", FIG6)
+    np.testing.assert_array_equal(again.timeseries, fig6_runs["rsg"].timeseries)
+
+
+def test_exact_qp_solver_gives_the_same_run(fig6_runs):
+    exact = run_lipm("rsg", scaled(FIG6, 2.0), qp_solver="exact")
+    proxqp = run_lipm("rsg", scaled(FIG6, 2.0), qp_solver="proxqp")
+    a = [s.event["position"] for s in exact.steps]
+    b = [s.event["position"] for s in proxqp.steps]
+    np.testing.assert_allclose(a, b, atol=1e-5)
+
+
+def test_comparison_controllers_respect_their_rules(fig6_runs):
+    for name in ("fixed-timing", "no-step"):
+        result = fig6_runs[name]
+        assert not any(s.event["timing_adjusted"] for s in result.steps), name
+        times = np.array([s.event["t"] for s in result.steps])
+        np.testing.assert_allclose(np.diff(times), 0.8, atol=0.003, err_msg=name)
+    assert not any(s.event["location_adjusted"] for s in fig6_runs["no-step"].steps)
+    assert any(s.event["location_adjusted"] for s in fig6_runs["fixed-timing"].steps)
+
+
+def test_zmp_stays_in_its_window_and_feet_never_cross(fig6_runs):
+    for name, result in fig6_runs.items():
+        assert result.violations["zmp_window"] == 0, name
+        assert result.violations["crossing"] == 0, name
+        sigma = result.column("stance_sigma")
+        foot_y = result.column("foot_y")
+        changes = np.flatnonzero(np.diff(sigma) != 0) + 1
+        for k in changes:  # the new stance foot is on its own side of the old one
+            assert sigma[k] * (foot_y[k] - foot_y[k - 1]) > 0, (name, k)

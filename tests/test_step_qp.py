@@ -1,0 +1,115 @@
+"""The step QP (27): constraints, optimality against brute force, fallback."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from planner.lyapunov import design_lyapunov
+from planner.parameters import Constraints, LipmModel, RsgParameters
+from planner.step_qp import build_step_qp, solve_box_exact, solve_step_qp
+
+CONSTRAINTS, PARAMS = Constraints(), RsgParameters()
+P_U = design_lyapunov(LipmModel(), CONSTRAINTS, PARAMS).matrix
+
+
+def random_problem(rng, sigma, anisotropic=False):
+    p = P_U
+    if anisotropic:
+        m = rng.normal(size=(2, 2))
+        p = m @ m.T + 0.1 * np.eye(2)
+    return build_step_qp(
+        p,
+        dcm_error=rng.normal(0, 0.1, 2),
+        xi1=np.array([rng.uniform(-0.2, 0.2), -sigma * rng.uniform(0.0, 0.15)]),
+        xi1_reference=np.array([rng.uniform(0.0, 0.12), -sigma * rng.uniform(0.05, 0.1)]),
+        sigma=sigma,
+        constraints=CONSTRAINTS,
+        params=PARAMS,
+    )
+
+
+def brute_force(problem, n=401):
+    lo, hi = problem.lower, problem.upper
+    xs, ys = np.linspace(lo[0], hi[0], n), np.linspace(lo[1], hi[1], n)
+    best, best_value = None, np.inf
+    for x, y in itertools.product(xs, ys):
+        u = np.array([x, y])
+        if problem.max_violation(u) <= 1e-12:
+            value = problem.objective(u)
+            if value < best_value:
+                best, best_value = u, value
+    return best, best_value
+
+
+@pytest.mark.parametrize(
+    "seed,sigma,anisotropic",
+    [(s, sg, a) for s in range(6) for sg in (1, -1) for a in (False, True)],
+)
+def test_solution_meets_constraints_and_matches_brute_force(seed, sigma, anisotropic):
+    rng = np.random.default_rng(seed)
+    problem = random_problem(rng, sigma, anisotropic)
+    solution = solve_step_qp(problem, "proxqp")
+    case = f"{seed=} {sigma=} {anisotropic=}"
+    if not solution.feasible:
+        pytest.skip(f"infeasible draw: {case}")
+    assert problem.max_violation(solution.step) < 1e-6, case  # (27b)-(27d)
+    _, grid_value = brute_force(problem, n=201)
+    grid_step = (problem.upper - problem.lower) / 200
+    slack = (
+        2
+        * float(np.max(np.linalg.eigvalsh(problem.lyapunov_matrix)))
+        * float(np.linalg.norm(grid_step))
+        * (np.linalg.norm(problem.target) + 1.0)
+    )
+    assert solution.lyapunov_after <= grid_value + 1e-9, case
+    assert solution.lyapunov_after >= grid_value - slack, case
+    exact = solve_box_exact(problem)
+    np.testing.assert_allclose(solution.step, exact, atol=1e-5, err_msg=case)
+
+
+def test_feet_never_cross_in_the_solution():
+    rng = np.random.default_rng(7)
+    for sigma in (1, -1):
+        for _ in range(50):
+            problem = random_problem(rng, sigma)
+            step = solve_step_qp(problem, "exact").step
+            # (27b): the new foot (-sigma) lands on its own side by 2 w_y + mu_2.
+            assert -sigma * step[1] >= 2 * CONSTRAINTS.half_width + PARAMS.crossing_margin - 1e-9
+
+
+def test_unconstrained_optimum_zeroes_the_dcm_error():
+    problem = build_step_qp(
+        P_U,
+        np.array([0.02, 0.01]),
+        np.array([0.1, -0.1]),
+        np.array([0.1, -0.1]),
+        sigma=1,
+        constraints=CONSTRAINTS,
+        params=PARAMS,
+    )
+    solution = solve_step_qp(problem)
+    assert solution.feasible
+    np.testing.assert_allclose(solution.step, problem.target, atol=1e-6)
+    assert solution.lyapunov_after == pytest.approx(0.0, abs=1e-10)
+
+
+def test_infeasible_problem_falls_back_without_27c():
+    """The CoM is far beyond the reach of the largest lateral step: (27c) is dropped."""
+    sigma = 1  # left stance, the right foot steps (sigma+ = -1)
+    problem = build_step_qp(
+        P_U,
+        np.array([0.0, -0.9]),
+        np.array([0.0, -0.9]),
+        np.array([0.1, -0.1]),
+        sigma=sigma,
+        constraints=CONSTRAINTS,
+        params=PARAMS,
+    )
+    lo, hi = problem.box()
+    assert lo[1] > hi[1], "the test case must be infeasible"
+    for solver in ("proxqp", "exact"):
+        solution = solve_step_qp(problem, solver)
+        assert not solution.feasible
+        assert problem.max_violation(solution.step, with_com=False) < 1e-6
+        assert solution.step[1] == pytest.approx(CONSTRAINTS.step_min[1], abs=1e-6)
