@@ -19,7 +19,7 @@ import numpy as np
 
 from planner.parameters import PlannerConfig
 from planner.step_generator import ReactiveStepGenerator
-from planner.types import Foothold, PlannerOutput, sigma_of
+from planner.types import Foothold, MeasuredState, PlannerOutput, Push, sigma_of
 
 from .backend import Backend, FallStatus, InitialCondition
 from .scenarios import Scenario
@@ -157,6 +157,113 @@ def _check_step(config: PlannerConfig, step: np.ndarray, new_foot: str) -> list[
     return failed
 
 
+class ClosedLoop:
+    """Planner and backend advanced one control tick at a time, everything recorded.
+
+    Used by the batch runner (:func:`run_closed_loop`) and by the live browser demo,
+    which adds pushes while it runs.
+
+    Args:
+        backend: The simulated robot.
+        config: Planner parameters; its model must match the backend.
+        scenario: Duration and pushes (already scaled to the robot's mass).
+        initial: Start state; default :func:`walking_start`.
+        qp_solver: ``"proxqp"`` or ``"exact"`` for the QP (27).
+        capacity: Ticks to pre-allocate for the time series (grows when needed).
+    """
+
+    def __init__(
+        self,
+        backend: Backend,
+        config: PlannerConfig,
+        scenario: Scenario,
+        initial: InitialCondition | None = None,
+        qp_solver: str = "proxqp",
+        capacity: int | None = None,
+    ) -> None:
+        self.backend = backend
+        self.config = config
+        self.scenario = scenario
+        self.initial = initial or walking_start(config)
+        self.generator = ReactiveStepGenerator(config, qp_solver=qp_solver)
+        self.period = backend.control_period
+        self._capacity = capacity or int(round(scenario.duration / self.period)) + 1
+        self.reset()
+
+    def reset(self) -> None:
+        """Start again from the initial condition (pushes added live are kept)."""
+        self.generator.reset(self.initial.stance, self.initial.swing)
+        self.rows = np.zeros((self._capacity, len(TIMESERIES_COLUMNS)))
+        self.ticks = 0
+        self.steps: list[StepRecord] = []
+        self.violations = dict.fromkeys(CONSTRAINTS, 0)
+        self.qp_infeasible = 0
+        self.wall_time = 0.0
+        self.last_output: PlannerOutput | None = None
+        self.measured = self.backend.reset(self.initial)
+
+    @property
+    def time(self) -> float:
+        """Simulated time of the next tick [s]."""
+        return self.ticks * self.period
+
+    def add_push(self, push: Push) -> None:
+        """Apply ``push`` too (its time is absolute [s])."""
+        self.scenario = self.scenario.with_pushes([push])
+
+    def tick(self) -> PlannerOutput:
+        """Run one control tick; returns the planner's output for it."""
+        start = wallclock.perf_counter()
+        time = self.time
+        measured = MeasuredState(time, self.measured.com_position, self.measured.com_velocity)
+        out = self.generator.update(measured, self.period)
+        if out.step is not None:
+            step = out.stance.position - out.previous_stance.position
+            self.steps.append(StepRecord(out.step.as_dict(), step.tolist()))
+            self.qp_infeasible += int(out.qp_infeasible)
+            for name in _check_step(self.config, step, out.stance.foot):
+                self.violations[name] += 1
+        for name in _check_tick(self.config, out, measured.com_position):
+            self.violations[name] += 1
+        force = self.scenario.force_average(time, self.period)
+        if self.ticks >= len(self.rows):
+            self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
+        self.rows[self.ticks] = (
+            time, *measured.com_position, *measured.com_velocity,
+            *out.zmp, *out.zmp_offset, *out.window_center,
+            *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
+            *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
+            *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
+        )  # fmt: skip
+        self.measured = self.backend.step(out, force)
+        self.ticks += 1
+        self.last_output = out
+        self.wall_time += wallclock.perf_counter() - start
+        return out
+
+    def result(self) -> RunResult:
+        """What has been recorded so far."""
+        return RunResult(
+            config=self.config,
+            scenario=self.scenario,
+            backend=self.backend.name,
+            mass=self.backend.mass,
+            com_height=self.backend.com_height,
+            timeseries=self.rows[: self.ticks].copy(),
+            steps=list(self.steps),
+            fall=self.backend.fall_status(),
+            violations=dict(self.violations),
+            qp_infeasible=self.qp_infeasible,
+            sim_time=self.ticks * self.period,
+            wall_time=self.wall_time,
+            lyapunov_threshold=self.generator.design.threshold,
+            extra={
+                "lyapunov_matrix": self.generator.design.matrix.tolist(),
+                "feedback_gain": self.generator.design.gain.tolist(),
+            },
+        )
+
+
 def run_closed_loop(
     backend: Backend,
     config: PlannerConfig,
@@ -178,65 +285,15 @@ def run_closed_loop(
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.
     """
-    initial = initial or walking_start(config)
-    generator = ReactiveStepGenerator(config, qp_solver=qp_solver)
-    generator.reset(initial.stance, initial.swing)
-    period = backend.control_period
-    ticks = int(round(scenario.duration / period))
-    rows = np.zeros((ticks, len(TIMESERIES_COLUMNS)))
-    steps: list[StepRecord] = []
-    violations = dict.fromkeys(CONSTRAINTS, 0)
-    qp_infeasible = 0
+    loop = ClosedLoop(backend, config, scenario, initial, qp_solver)
+    ticks = int(round(scenario.duration / loop.period))
     report_every = max(1, ticks // 100)
-
-    start = wallclock.perf_counter()
-    measured = backend.reset(initial)
-    done = 0
     for tick in range(ticks):
-        time = tick * period
-        measured = type(measured)(time, measured.com_position, measured.com_velocity)
-        out = generator.update(measured, period)
-        if out.step is not None:
-            step = out.stance.position - out.previous_stance.position
-            steps.append(StepRecord(out.step.as_dict(), step.tolist()))
-            qp_infeasible += int(out.qp_infeasible)
-            for name in _check_step(config, step, out.stance.foot):
-                violations[name] += 1
-        for name in _check_tick(config, out, measured.com_position):
-            violations[name] += 1
-        force = scenario.force_average(time, period)
-        rows[tick] = (
-            time, *measured.com_position, *measured.com_velocity,
-            *out.zmp, *out.zmp_offset, *out.window_center,
-            *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
-            *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
-            *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
-        )  # fmt: skip
-        measured = backend.step(out, force)
-        done = tick + 1
+        loop.tick()
         if progress is not None and tick % report_every == 0:
             progress(tick / ticks)
         if backend.fall_status().fell:
             break
-    wall = wallclock.perf_counter() - start
     if progress is not None:
         progress(1.0)
-    return RunResult(
-        config=config,
-        scenario=scenario,
-        backend=backend.name,
-        mass=backend.mass,
-        com_height=backend.com_height,
-        timeseries=rows[:done],
-        steps=steps,
-        fall=backend.fall_status(),
-        violations=violations,
-        qp_infeasible=qp_infeasible,
-        sim_time=done * period,
-        wall_time=wall,
-        lyapunov_threshold=generator.design.threshold,
-        extra={
-            "lyapunov_matrix": generator.design.matrix.tolist(),
-            "feedback_gain": generator.design.gain.tolist(),
-        },
-    )
+    return loop.result()

@@ -12,6 +12,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
+from typing import Any
 
 from planner.exceptions import ParameterError
 
@@ -88,6 +89,16 @@ class RobotDescription:
         fall_tilt: Pelvis tilt from vertical [rad] over which it counts as fallen.
         swing_height: Apex height of the swing sole above the ground [m].
         ground_friction: Lateral friction coefficient of the ground and soles [-].
+        stride_length: Nominal L_x of the planner's gait [m].
+        step_width: Nominal L_y [m].
+        double_support_duration: Nominal T_DSP [s].
+        single_support_duration: Nominal T_SSP [s].
+        step_min: Lower bound u_d^m of a step (x, y) [m] (leg reach).
+        step_max: Upper bound u_d^M of a step (x, y) [m].
+        angular_momentum_rate_max: Bound on the feedback hdot [N m].
+        lqr_dcm_error_scale: DCM error scale e_max of the LQR (Bryson) [m].
+        backend_options: Keyword arguments of the PyBullet backend tuned for
+            this robot (CoM tracking), see :class:`app.pybullet_backend.PyBulletBackend`.
     """
 
     name: str
@@ -108,6 +119,15 @@ class RobotDescription:
     fall_tilt: float = math.radians(45.0)
     swing_height: float = 0.06
     ground_friction: float = 1.0
+    stride_length: float = 0.1
+    step_width: float = 0.2
+    double_support_duration: float = 0.1
+    single_support_duration: float = 0.7
+    step_min: tuple[float, float] = (-0.25, -0.4)
+    step_max: tuple[float, float] = (0.35, 0.4)
+    angular_momentum_rate_max: float = 3.0
+    lqr_dcm_error_scale: float = 0.03
+    backend_options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not self.name or not self.name.isidentifier():

@@ -76,4 +76,5 @@ G1 = RobotDescription(
     total_mass=33.3,
     fall_base_height=0.45,
     swing_height=0.06,
+    backend_options={"com_reference_blend": 0.05, "com_tracking_gains": (1.0, 0.0)},
 )

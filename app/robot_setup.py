@@ -1,0 +1,78 @@
+"""Planner configuration and backend for a full robot in PyBullet."""
+
+from __future__ import annotations
+
+from planner.parameters import (
+    Constraints,
+    GaitParameters,
+    LipmModel,
+    PlannerConfig,
+    RsgParameters,
+)
+from robots import get_robot
+from robots.description import RobotDescription
+
+from .backend import InitialCondition
+from .runner import walking_start
+
+ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the sole's edges
+
+
+def planner_config_for(
+    description: RobotDescription, mass: float, controller: str = "rsg"
+) -> PlannerConfig:
+    """The planner's parameters for a robot: its mass, CoM height, sole and gait.
+
+    Args:
+        description: The robot.
+        mass: Mass measured in the simulator [kg].
+        controller: ``rsg``, ``fixed-timing`` or ``no-step``.
+    """
+    sole = description.sole
+    half_width = sole.half_width - ZMP_MARGIN
+    return PlannerConfig(
+        model=LipmModel(mass=mass, com_height=description.com_height),
+        gait=GaitParameters(
+            stride_length=description.stride_length,
+            step_width=description.step_width,
+            double_support_duration=description.double_support_duration,
+            single_support_duration=description.single_support_duration,
+        ),
+        constraints=Constraints(
+            zmp_window_min=(sole.x_min + ZMP_MARGIN, -half_width),
+            zmp_window_max=(sole.x_max - ZMP_MARGIN, half_width),
+            angular_momentum_rate_max=description.angular_momentum_rate_max,
+            step_min=description.step_min,
+            step_max=description.step_max,
+        ),
+        rsg=RsgParameters(
+            lqr_dcm_error_scale=description.lqr_dcm_error_scale,
+            lqr_zmp_scale=half_width,
+            lqr_angular_momentum_scale=description.angular_momentum_rate_max,
+        ),
+        controller=controller,
+    )
+
+
+def build_robot_backend(robot: str, controller: str):  # noqa: ANN201
+    """PyBullet backend, planner configuration and walking start for ``robot``.
+
+    Raises:
+        ParameterError: Unknown robot.
+    """
+    from kinematics.swing_foot import SwingTiming
+
+    from .pybullet_backend import PyBulletBackend
+
+    description = get_robot(robot)
+    backend = PyBulletBackend(description, **description.backend_options)
+    config = planner_config_for(description, backend.mass, controller)
+    timing = SwingTiming(
+        config.gait.double_support_duration,
+        config.rsg.swing_preparation_time,
+        config.gait.step_duration,
+    )
+    backend.timing = timing
+    backend.swing.timing = timing
+    initial: InitialCondition = walking_start(config)
+    return backend, config, initial
