@@ -12,9 +12,8 @@ Each control tick (``control_period``, several 1 ms physics steps):
    drifts and falls within 1 s; blend 0 stands indefinitely.
 2. Feet: the stance sole is put flat at ``command.stance.position``; the swing
    sole follows :class:`SwingFootTrajectory` toward ``command.next_step.position``
-   with the planner's timing: touchdown at ``command.extra["planned_step_time"]``
-   (absolute time [s]) when the planner provides it, else at the nominal step
-   time. The planner's jump (``command.step``) happens at its planned time: the
+   with the planner's timing: touchdown ``touchdown_lead`` before
+   ``command.next_step_time`` (absolute [s], re-planned every tick). The planner's jump (``command.step``) happens at its planned time: the
    swing foot becomes the stance foot at the step position at once.
 3. Whole-body IK (placo) -> joint position targets (velocity feed-forward from
    the difference of successive solutions) -> PyBullet POSITION_CONTROL.
@@ -42,7 +41,6 @@ from planner.types import Foot, MeasuredState, PlannerOutput, Vector2, other_foo
 from robots import get_robot
 from robots.description import RobotDescription
 
-PLANNED_STEP_TIME = "planned_step_time"  # optional PlannerOutput.extra key [s]
 INITIAL_VELOCITY_HORIZON = 0.01  # [s] finite difference used to start with a CoM velocity
 
 
@@ -70,6 +68,9 @@ class PyBulletBackend:
         arrival_lead: float = 0.1,
         use_angular_momentum: bool = False,
         interpolate_targets: bool = True,
+        touchdown_lead: float = 0.0,
+        touchdown_depth: float = 0.0,
+        plan_angular_momentum: str = "full",
     ) -> None:
         """Load the robot.
 
@@ -93,6 +94,16 @@ class PyBulletBackend:
                 it is not realised by an upper-body motion.
             interpolate_targets: Interpolate the joint targets linearly over the
                 physics steps of a tick (else hold the tick's final target).
+            touchdown_lead: The swing foot lands this long before the planner's
+                step time [s].
+            touchdown_depth: Once down, the swing sole target is this far below the
+                ground [m], so the foot is loaded before it becomes the stance foot.
+            plan_angular_momentum: Which hdot enters the CoM plan: ``"full"`` (the
+                planner's hdot, with its double-support compensation: the plan's
+                effective ZMP jumps to the new foot at the step), ``"feedback"``
+                (without it: the plan's ZMP moves along the moving window from the
+                old foot to the new one over T_DSP, as the feet can realise) or
+                ``"none"``.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -108,6 +119,19 @@ class PyBulletBackend:
         self.com_reference_blend = com_reference_blend
         self.com_tracking_gains = com_tracking_gains
         self.interpolate_targets = interpolate_targets
+        if not (0.0 <= touchdown_lead <= 0.2 and 0.0 <= touchdown_depth <= 0.02):
+            raise ParameterError(
+                "touchdown_lead/touchdown_depth",
+                (touchdown_lead, touchdown_depth),
+                "lead in [0, 0.2] s and depth in [0, 0.02] m",
+            )
+        self.touchdown_lead = touchdown_lead
+        if plan_angular_momentum not in ("full", "feedback", "none"):
+            raise ParameterError(
+                "plan_angular_momentum", plan_angular_momentum, "full, feedback or none"
+            )
+        self.plan_angular_momentum = plan_angular_momentum
+        self.touchdown_depth = touchdown_depth
         self._com_reference = np.zeros(2)
         self._com_velocity_reference = np.zeros(2)
         self.timing = timing or SwingTiming()
@@ -192,11 +216,14 @@ class PyBulletBackend:
             self._stance = stance
         com_target = self._advance_com_reference(command)
         time_since_step = command.time_since_step + dt
-        planned_step_time = command.extra.get(PLANNED_STEP_TIME)
-        landing = None
-        if planned_step_time is not None:
-            landing = float(planned_step_time) - (command.time - command.time_since_step)
+        # Touchdown a little before the planner's step so the foot carries load
+        # when the stance switches (measured: landing exactly at the switch leaves
+        # the CoP on the old foot for ~30 ms and costs ~2 cm of DCM error).
+        landing = (
+            command.next_step_time - (command.time - command.time_since_step)
+        ) - self.touchdown_lead
         swing_position = self.swing.update(time_since_step, command.next_step.position, dt, landing)
+        swing_position[2] = max(swing_position[2] - self._press_depth(swing_position), -0.01)
         soles = {
             stance: _ground_pose(command.stance.position),
             swing_foot: sole_pose(swing_position),
@@ -224,6 +251,10 @@ class PyBulletBackend:
         self.ticks += 1
         return self._measured
 
+    def _press_depth(self, swing_position: NDArray[np.float64]) -> float:
+        """How far below the ground the landed swing sole is commanded [m]."""
+        return self.touchdown_depth if swing_position[2] <= 1e-4 else 0.0
+
     def _advance_com_reference(self, command: PlannerOutput) -> NDArray[np.float64]:
         """Blend the CoM reference toward the measurement, integrate it, return the IK target."""
         measured = self._measured
@@ -238,11 +269,16 @@ class PyBulletBackend:
         blend = self.com_reference_blend
         self._com_reference = self._com_reference - blend * position_error
         self._com_velocity_reference = self._com_velocity_reference - blend * velocity_error
+        hdot = {
+            "full": command.angular_momentum_rate,
+            "feedback": command.angular_momentum_rate_feedback,
+            "none": np.zeros(2),
+        }[self.plan_angular_momentum]
         self._com_reference, self._com_velocity_reference = lipm_integrate(
             self._com_reference,
             self._com_velocity_reference,
             command.zmp,
-            command.angular_momentum_rate,
+            hdot,
             self.mass,
             self.com_height,
             self.control_period,
@@ -253,7 +289,7 @@ class PyBulletBackend:
             self._com_reference,
             self._com_velocity_reference,
             command.zmp,
-            command.angular_momentum_rate,
+            hdot,
             self.mass,
             self.com_height,
             self.com_lookahead,

@@ -169,6 +169,23 @@ class ReactiveStepGenerator:
         future = flow_autonomous(self.omega, self.reference.state, wait)
         return self.stance + 2.0 * future[:2]
 
+    def predicted_step_time(self, time: float, level: float) -> float:
+        """When the next step is expected [s], re-planned at each tick.
+
+        While V_u >= gamma_v and timing adjustment is on, D_T,1 fires as soon as the
+        swing foot can land (s~ = T_DSP + T_SP) or now if that is past; otherwise
+        the step comes when the reference reaches D_S.
+        """
+        gait, rsg = self.config.gait, self.config.rsg
+        earliest = gait.double_support_duration + rsg.swing_preparation_time
+        wait_ready = max(earliest - self.time_since_step, 0.0)
+        if self.config.adjusts_timing and level >= self.design.threshold:
+            return time + wait_ready
+        wait = max(self.reference.time_to_nominal_jump(), wait_ready)
+        if not math.isfinite(wait):
+            wait = wait_ready
+        return time + wait
+
     # ------------------------------------------------------------ one tick
     def update(self, measured: MeasuredState, period: float) -> PlannerOutput:
         """Run one control tick: jump if (chi, eta) is in D, then flow for ``period``.
@@ -226,6 +243,7 @@ class ReactiveStepGenerator:
             stance=Foothold(_foot_of(self.sigma), self.stance.copy()),
             previous_stance=Foothold(_foot_of(-self.sigma), self.previous.copy()),
             next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi)),
+            next_step_time=self.predicted_step_time(measured.time, level),
             time_since_step=self.time_since_step,
             double_support=self.time_since_step < self.config.gait.double_support_duration,
             dcm_error=error,

@@ -139,6 +139,9 @@ class PlannerOutput:
         stance: Current stance foothold (o_H, sigma).
         previous_stance: Stance foothold before the last step.
         next_step: Where the swing foot is planned to land (re-planned every tick).
+        next_step_time: When the planner expects to step [s] (re-planned every tick):
+            the reference's next nominal jump, or the earliest step time
+            s_{j-1} + T_DSP + T_SP while D_T,1 is about to fire.
         time_since_step: s~ = t - s_{j-1} [s].
         double_support: True while s~ < T_DSP.
         dcm_error: e_u (18) [m].
@@ -158,6 +161,7 @@ class PlannerOutput:
     stance: Foothold
     previous_stance: Foothold
     next_step: Foothold
+    next_step_time: float
     time_since_step: float
     double_support: bool
     dcm_error: Vector2

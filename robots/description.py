@@ -97,6 +97,8 @@ class RobotDescription:
         step_max: Upper bound u_d^M of a step (x, y) [m].
         angular_momentum_rate_max: Bound on the feedback hdot [N m].
         lqr_dcm_error_scale: DCM error scale e_max of the LQR (Bryson) [m].
+        sole_box_collision: Replace the foot's collision shapes by a box spanning
+            the sole rectangle in the derived URDF.
         backend_options: Keyword arguments of the PyBullet backend tuned for
             this robot (CoM tracking), see :class:`app.pybullet_backend.PyBulletBackend`.
     """
@@ -127,6 +129,7 @@ class RobotDescription:
     step_max: tuple[float, float] = (0.35, 0.4)
     angular_momentum_rate_max: float = 3.0
     lqr_dcm_error_scale: float = 0.03
+    sole_box_collision: bool = False
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -76,5 +76,11 @@ G1 = RobotDescription(
     total_mass=33.3,
     fall_base_height=0.45,
     swing_height=0.06,
-    backend_options={"com_reference_blend": 0.05, "com_tracking_gains": (1.0, 0.0)},
+    sole_box_collision=True,
+    backend_options={
+        "com_reference_blend": 0.05,
+        "com_tracking_gains": (1.0, 0.0),
+        "touchdown_lead": 0.05,
+        "touchdown_depth": 0.005,
+    },
 )

@@ -3,7 +3,10 @@
 The installed URDFs cannot be used as they are: meshes are ``package://`` URIs
 (pinocchio/placo cannot resolve them), placo's ``HumanoidRobot`` needs the frames
 ``left_foot``, ``right_foot`` and ``trunk``, and PyBullet gives 1 kg to every link
-without ``<inertial>``. :func:`derived_urdf` writes a fixed copy to
+without ``<inertial>``. When the description asks for it (``sole_box_collision``),
+the foot's collision shapes (G1: four 5 mm spheres, which chatter and bounce in
+PyBullet at every touchdown) are replaced by one thin box spanning the sole
+rectangle, bottom face on the sole plane. :func:`derived_urdf` writes a fixed copy to
 ``$RSG_CACHE_DIR/robots/<name>-<hash>/robot.urdf`` (default cache
 ``~/.cache/rsg``). The hash covers the source text and the derivation settings, so
 the same input always gives the same file, and a new input a new folder.
@@ -23,7 +26,7 @@ from robots.description import RobotDescription
 
 DISTRIBUTION = "example-robot-data"
 PACKAGE_PREFIX = "package://"
-DERIVATION_VERSION = "1"  # bump when the derivation below changes
+DERIVATION_VERSION = "2"  # bump when the derivation below changes
 TINY_MASS = 1e-6  # [kg] mass given to links without <inertial>
 TINY_INERTIA = 1e-9  # [kg m^2]
 FOOT_FRAMES = {"left": "left_foot", "right": "right_foot"}
@@ -95,6 +98,23 @@ def _add_tiny_inertial(link: ET.Element) -> None:
     )
 
 
+SOLE_BOX_THICKNESS = 0.01  # [m]
+
+
+def _replace_sole_collision(root: ET.Element, description: RobotDescription, link: str) -> None:
+    """Replace the collision shapes of ``link`` by a box under the sole rectangle."""
+    element = next(e for e in root.iter("link") if e.get("name") == link)
+    for collision in element.findall("collision"):
+        element.remove(collision)
+    sole, (x, y, z) = description.sole, description.sole_offset
+    collision = ET.SubElement(element, "collision")
+    center = (x + (sole.x_min + sole.x_max) / 2, y, z + SOLE_BOX_THICKNESS / 2)
+    ET.SubElement(collision, "origin", xyz=" ".join(f"{v:g}" for v in center), rpy="0 0 0")
+    geometry = ET.SubElement(collision, "geometry")
+    size = (sole.x_max - sole.x_min, 2 * sole.half_width, SOLE_BOX_THICKNESS)
+    ET.SubElement(geometry, "box", size=" ".join(f"{v:g}" for v in size))
+
+
 _INERTIA_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
 
@@ -124,6 +144,8 @@ def derive_urdf_text(description: RobotDescription, source_text: str, share_dir:
             _add_tiny_inertial(link)
     for foot, frame in FOOT_FRAMES.items():
         _add_fixed_frame(root, frame, description.ankle_link(foot), description.sole_offset)
+        if description.sole_box_collision:
+            _replace_sole_collision(root, description, description.ankle_link(foot))
     _add_fixed_frame(root, TRUNK_FRAME, description.trunk_link, (0.0, 0.0, 0.0))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"

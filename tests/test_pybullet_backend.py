@@ -39,6 +39,7 @@ def command(
         stance=stance,
         previous_stance=swing,
         next_step=next_step or swing,
+        next_step_time=time - since_step + 0.8,
         time_since_step=since_step,
         double_support=since_step < 0.1,
         dcm_error=np.zeros(2),
