@@ -148,43 +148,42 @@ class ReactiveStepGenerator:
             return solution.step, True, solution.feasible
         return self.reference.nominal_step(), False, True
 
-    def preview_step(self, xi: np.ndarray) -> np.ndarray:
+    def _nominal_wait(self) -> float:
+        """Time [s] until the gated D_S: the reference's jump, not before s~ = T_DSP + T_SP."""
+        gait, rsg = self.config.gait, self.config.rsg
+        ready = gait.double_support_duration + rsg.swing_preparation_time - self.time_since_step
+        wait = max(self.reference.time_to_nominal_jump(), ready, 0.0)
+        return wait if math.isfinite(wait) else max(ready, 0.0)
+
+    def preview_step(self, xi: np.ndarray, nominal_wait: float | None = None) -> np.ndarray:
         """Where the next step would land [m], re-planned at each tick.
 
         With V_u >= gamma_v it is the QP (27) at the current state; otherwise the
-        nominal step 2 xi1* at the reference's next nominal jump.
+        nominal step 2 xi1* at the reference's next (gated) nominal jump.
         """
         error = self.dcm_error(xi)
         level = self.design.level(error)
         if self.config.adjusts_location and level >= self.design.threshold:
             step, _, _ = self._step_location(xi[:2], error, level, "exact")
             return self.stance + step
-        gait, rsg = self.config.gait, self.config.rsg
-        wait = max(
-            self.reference.time_to_nominal_jump(),
-            gait.double_support_duration + rsg.swing_preparation_time - self.time_since_step,
-        )
-        if not math.isfinite(wait):
-            wait = 0.0
+        wait = self._nominal_wait() if nominal_wait is None else nominal_wait
         future = flow_autonomous(self.omega, self.reference.state, wait)
         return self.stance + 2.0 * future[:2]
 
-    def predicted_step_time(self, time: float, level: float) -> float:
+    def predicted_step_time(
+        self, time: float, level: float, nominal_wait: float | None = None
+    ) -> float:
         """When the next step is expected [s], re-planned at each tick.
 
         While V_u >= gamma_v and timing adjustment is on, D_T,1 fires as soon as the
         swing foot can land (s~ = T_DSP + T_SP) or now if that is past; otherwise
         the step comes when the reference reaches D_S.
         """
-        gait, rsg = self.config.gait, self.config.rsg
-        earliest = gait.double_support_duration + rsg.swing_preparation_time
-        wait_ready = max(earliest - self.time_since_step, 0.0)
         if self.config.adjusts_timing and level >= self.design.threshold:
-            return time + wait_ready
-        wait = max(self.reference.time_to_nominal_jump(), wait_ready)
-        if not math.isfinite(wait):
-            wait = wait_ready
-        return time + wait
+            gait, rsg = self.config.gait, self.config.rsg
+            earliest = gait.double_support_duration + rsg.swing_preparation_time
+            return time + max(earliest - self.time_since_step, 0.0)
+        return time + (self._nominal_wait() if nominal_wait is None else nominal_wait)
 
     # ------------------------------------------------------------ one tick
     def update(self, measured: MeasuredState, period: float) -> PlannerOutput:
@@ -230,6 +229,7 @@ class ReactiveStepGenerator:
             error = self.dcm_error(xi)
             level = self.design.level(error)
 
+        nominal_wait = self._nominal_wait()
         window_offset = self.window_offset()
         zmp_offset = self.filter_state[:2].copy()
         angular_momentum_rate = self.filter_state[2:] + self.compensation_state
@@ -242,8 +242,8 @@ class ReactiveStepGenerator:
             angular_momentum_rate_feedback=self.filter_state[2:].copy(),
             stance=Foothold(_foot_of(self.sigma), self.stance.copy()),
             previous_stance=Foothold(_foot_of(-self.sigma), self.previous.copy()),
-            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi)),
-            next_step_time=self.predicted_step_time(measured.time, level),
+            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi, nominal_wait)),
+            next_step_time=self.predicted_step_time(measured.time, level, nominal_wait),
             time_since_step=self.time_since_step,
             double_support=self.time_since_step < self.config.gait.double_support_duration,
             dcm_error=error,

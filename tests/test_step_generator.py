@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
+from app.runner import walking_start
 from app.scenarios import BUILT_IN
 from conftest import run_lipm, scaled
+from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import PlannerConfig
 from planner.step_generator import ReactiveStepGenerator
 from planner.types import Foothold, MeasuredState
@@ -135,3 +137,28 @@ def test_zmp_stays_in_its_window_and_feet_never_cross(fig6_runs):
         changes = np.flatnonzero(np.diff(sigma) != 0) + 1
         for k in changes:  # the new stance foot is on its own side of the old one
             assert sigma[k] * (foot_y[k] - foot_y[k - 1]) > 0, (name, k)
+
+
+def test_predicted_step_time_and_location_match_the_step_taken():
+    """In nominal walking the preview (next_step, next_step_time) is where and when the
+    planner actually steps, from anywhere in the cycle (the swing foot relies on it)."""
+    config = PlannerConfig()
+    initial = walking_start(config)
+    generator = ReactiveStepGenerator(config)
+    generator.reset(initial.stance, initial.swing)
+    com, velocity = initial.com_position, initial.com_velocity
+    dt, checked, predictions = 0.001, 0, []
+    for k in range(int(3.0 / dt)):
+        out = generator.update(MeasuredState(k * dt, com, velocity), dt)
+        if out.step is not None:
+            for when, where in predictions:
+                assert abs(when - out.step.time) <= 2 * dt, f"{when=} {out.step.time=}"
+                np.testing.assert_allclose(where, out.step.position, atol=2e-3)
+                checked += 1
+            predictions = []
+        elif k % 50 == 0:
+            predictions.append((out.next_step_time, out.next_step.position))
+        com, velocity = integrate_lipm(
+            config.model, com, velocity, out.zmp, out.angular_momentum_rate, np.zeros(2), dt
+        )
+    assert checked > 20
