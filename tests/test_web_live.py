@@ -1,0 +1,68 @@
+"""The live simulation thread of the browser demo, on the fast LIPM backend."""
+
+from __future__ import annotations
+
+import re
+import time
+
+import pytest
+
+from web.live import LiveSimulation
+from web.scene_model import paper_presets
+
+
+def wait_for(condition, timeout: float = 20.0) -> bool:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if condition():
+            return True
+        time.sleep(0.02)
+    return False
+
+
+def test_push_gives_adjusted_step_and_reset_restarts():
+    lines: list[str] = []
+    live = LiveSimulation("lipm", "g1", "rsg", "walk", log=lines.append)
+    live.start()
+    try:
+        assert wait_for(lambda: live.snapshot().status.time > 0.3)
+        status = live.snapshot().status
+        assert status.controller == "rsg" and not status.fell and status.speed >= 0.0
+        live.request_push(next(iter(paper_presets(live.snapshot().mass).values())))
+        assert wait_for(lambda: any(" adjusted=yes" in line for line in lines))
+        push = next(line for line in lines if line.startswith("push "))
+        assert re.search(r"t=\d+\.\d+ s impulse=\(8\.00, -6\.00\) N s duration=0\.100 s", push)
+        step = next(line for line in lines if "adjusted=yes" in line)
+        assert re.match(r"step t=\d+\.\d+ s foot=(left|right) position=\(.+\) m", step)
+        assert wait_for(lambda: live.snapshot().adjusted_steps >= 1)  # published after the line
+        snap = live.snapshot()
+        assert snap.pushes_applied == 1
+        assert snap.state is not None and len(snap.state.dcm_error_trail) > 10
+
+        live.set_paused(True)
+        assert wait_for(lambda: live.snapshot().status.paused)
+        paused_at = live.snapshot().status.time
+        time.sleep(0.2)
+        assert live.snapshot().status.time == pytest.approx(paused_at)
+        live.set_paused(False)
+
+        live.request_reset()
+        assert wait_for(lambda: any(line.startswith("reset") for line in lines))
+        assert wait_for(lambda: live.snapshot().pushes_applied == 0)
+        assert live.snapshot().status.time < paused_at + 1.0
+    finally:
+        live.stop()
+
+
+def test_controller_change_and_bad_requests():
+    live = LiveSimulation("lipm", "g1", "rsg", "walk", log=lambda _: None)
+    live.start()
+    try:
+        live.request_controller("no-step")
+        assert wait_for(lambda: live.snapshot().status.controller == "no-step")
+        with pytest.raises(ValueError, match="controller"):
+            live.request_controller("magic")
+        with pytest.raises(ValueError, match="slow motion"):
+            live.set_slow_motion(3.0)
+    finally:
+        live.stop()
