@@ -95,6 +95,14 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, required=True, help="folder for the results")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
+    from web.cli_demo import add_demo_parser
+
+    add_demo_parser(sub)
+    from .bench import add_bench_parser
+    from .sweep_command import add_sweep_parser
+
+    add_sweep_parser(sub)
+    add_bench_parser(sub)
     return parser
 
 
@@ -107,6 +115,18 @@ def main(argv: list[str] | None = None) -> int:
             from .run_command import run_command
 
             return run_command(args)
+        if args.command == "demo":
+            from web.demo import main as demo_main
+
+            return demo_main(args)
+        if args.command == "sweep":
+            from .sweep_command import sweep_command
+
+            return sweep_command(args)
+        if args.command == "bench":
+            from .bench import bench_command
+
+            return bench_command(args)
     except RsgError as exc:
         print(f"rsg {args.command}: error: {exc}", file=sys.stderr)
         return 2

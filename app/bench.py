@@ -1,0 +1,259 @@
+"""``rsg bench``: how long the parts of the loop take, per call.
+
+Measured in one process, one after the other:
+
+- ``rsg_tick``: :meth:`ReactiveStepGenerator.update` on ticks without a step (the
+  continuous part: error, Lyapunov level, D_T test, filter, preview), on the LIPM
+  with the paper's Fig. 6 pushes; ``rsg_step_tick``: the ticks with a step (QP);
+- ``qp_proxqp`` / ``qp_exact``: the step QP (27) by qpsolvers/proxqp and by the exact
+  box method, on problems sampled around the states the RSG meets (random DCM
+  errors, both stance feet); the two solutions are compared (share within 1e-4 m,
+  largest difference, and whether the exact one's objective is ever worse);
+- ``ik``, ``physics``: one whole-body IK solve and one 1 ms PyBullet step, timed by
+  wrappers put around ``backend.ik.solve`` and ``backend.sim.step`` of a PyBullet
+  walk (the backend's files are not touched);
+- ``loop``: one control tick of the full-robot closed loop, and its real-time factor.
+
+Each figure is the median and 95th percentile [s] over the calls. The placo-wpg
+baseline's planner column is filled when :mod:`app.placo_wpg` provides one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from planner.exceptions import ParameterError, RsgError
+from planner.lyapunov import design_lyapunov
+from planner.parameters import PlannerConfig
+from planner.step_qp import build_step_qp, solve_step_qp
+
+from .lipm_backend import LipmBackend
+from .runner import ClosedLoop
+from .scenarios import BUILT_IN, Scenario
+
+QP_AGREEMENT = 1e-4  # [m] proxqp and the exact method "agree" within this
+
+
+def stats(samples: list[float]) -> dict:
+    """Median, 95th percentile [s] and count of ``samples``."""
+    if not samples:
+        return {"median": None, "p95": None, "count": 0}
+    data = np.asarray(samples)
+    return {
+        "median": float(np.median(data)),
+        "p95": float(np.percentile(data, 95)),
+        "count": len(samples),
+    }
+
+
+def timed(function: Callable, sink: list[float]) -> Callable:
+    """``function`` that appends its wall time per call [s] to ``sink``."""
+
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        start = time.perf_counter()
+        try:
+            return function(*args, **kwargs)
+        finally:
+            sink.append(time.perf_counter() - start)
+
+    return wrapper
+
+
+def bench_rsg_ticks(duration: float = 12.0) -> dict:
+    """Time the RSG's update on the LIPM with the paper-fig6 pushes."""
+    config = PlannerConfig()
+    scenario = BUILT_IN["paper-fig6"]
+    scenario = Scenario(scenario.name, min(duration, scenario.duration), scenario.pushes)
+    loop = ClosedLoop(LipmBackend(config.model), config, scenario, qp_solver="proxqp")
+    flow: list[float] = []
+    jump: list[float] = []
+    update = loop.generator.update
+    for _ in range(int(round(scenario.duration / loop.period))):
+        measured_before = loop.measured
+        start = time.perf_counter()
+        out = update(measured_before, loop.period)
+        elapsed = time.perf_counter() - start
+        (jump if out.step is not None else flow).append(elapsed)
+        loop.measured = loop.backend.step(out, scenario.force_average(loop.time, loop.period))
+        loop.ticks += 1
+    return {"rsg_tick": stats(flow), "rsg_step_tick": stats(jump)}
+
+
+def bench_step_qp(samples: int = 500, seed: int = 0) -> dict:
+    """Time proxqp and the exact box method on sampled QPs (27); check they agree."""
+    config = PlannerConfig()
+    design = design_lyapunov(config.model, config.constraints, config.rsg)
+    rng = np.random.default_rng(seed)
+    proxqp, exact = [], []
+    differences, exact_not_worse = [], True
+    for index in range(samples):
+        sigma = 1 if index % 2 else -1
+        xi1_ref = np.array([rng.uniform(-0.1, 0.1), -sigma * rng.uniform(0.0, 0.1)])
+        error = rng.normal(0.0, 0.15, 2)
+        xi1 = xi1_ref + rng.normal(0.0, 0.05, 2)
+        problem = build_step_qp(
+            design.matrix, error, xi1, xi1_ref, sigma, config.constraints, config.rsg
+        )
+        start = time.perf_counter()
+        a = solve_step_qp(problem, "proxqp")
+        middle = time.perf_counter()
+        b = solve_step_qp(problem, "exact")
+        proxqp.append(middle - start)
+        exact.append(time.perf_counter() - middle)
+        differences.append(float(np.max(np.abs(a.step - b.step))))
+        exact_not_worse &= problem.objective(b.step) <= problem.objective(a.step) + 1e-6
+    agree = np.asarray(differences) < QP_AGREEMENT
+    return {
+        "qp_proxqp": stats(proxqp),
+        "qp_exact": stats(exact),
+        "qp_samples": samples,
+        "qp_agree_fraction": float(agree.mean()),
+        "qp_max_difference": float(max(differences)),
+        "qp_equal": bool(agree.all()),
+        "qp_exact_objective_not_worse": bool(exact_not_worse),
+    }
+
+
+def bench_robot(robot: str, duration: float) -> dict:
+    """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then)."""
+    from .setup import build_backend
+
+    backend, config, initial = build_backend("pybullet", robot, "rsg")
+    ik_times: list[float] = []
+    physics_times: list[float] = []
+    tick_times: list[float] = []
+    try:
+        backend.ik.solve = timed(backend.ik.solve, ik_times)  # type: ignore[attr-defined]
+        backend.sim.step = timed(backend.sim.step, physics_times)  # type: ignore[attr-defined]
+        loop = ClosedLoop(backend, config, Scenario("walk", duration), initial)
+        ik_times.clear()  # the reset's solves are not ticks
+        wall = time.perf_counter()
+        for _ in range(int(round(duration / loop.period))):
+            start = time.perf_counter()
+            loop.tick()
+            tick_times.append(time.perf_counter() - start)
+            if backend.fall_status().fell:
+                break
+        wall = time.perf_counter() - wall
+        sim = loop.ticks * loop.period
+        fall = backend.fall_status()
+        ticks = max(getattr(backend, "ticks", 1), 1)
+        timers = {k: v / ticks for k, v in getattr(backend, "timers", {}).items()}
+    finally:
+        backend.close()
+    return {
+        "ik": stats(ik_times),
+        "physics": stats(physics_times),
+        "loop_tick": stats(tick_times),
+        "real_time_factor": sim / wall if wall > 0 else None,
+        "simulated": sim,
+        "fell": fall.fell,
+        "fall_reason": fall.reason,
+        "backend_timers_mean_per_tick": timers,
+        "control_period": loop.period,
+    }
+
+
+def bench_placo_wpg(robot: str, duration: float) -> dict | None:
+    """The same figures for the placo-wpg baseline, if it exists."""
+    try:
+        from .placo_wpg import bench_figures  # type: ignore[attr-defined]
+    except ImportError:
+        return None
+    result: dict = bench_figures(robot, duration)
+    return result
+
+
+ROWS = (
+    ("rsg_tick", "planner tick (continuous part)"),
+    ("rsg_step_tick", "planner tick with a step"),
+    ("qp_proxqp", "step QP, proxqp"),
+    ("qp_exact", "step QP, exact box"),
+    ("ik", "IK solve"),
+    ("physics", "physics step (1 ms)"),
+    ("loop_tick", "whole control tick"),
+)
+
+
+def format_bench(report: dict) -> str:
+    """Markdown table: median and p95 [us] per part, beside placo-wpg's."""
+    other = report.get("placo_wpg") or {}
+    lines = [
+        "| part | rsg median [us] | rsg p95 [us] | placo-wpg median [us] | placo-wpg p95 [us] |",
+        "|---|---|---|---|---|",
+    ]
+    for key, label in ROWS:
+        mine, theirs = report.get(key) or {}, other.get(key) or {}
+        lines.append(
+            f"| {label} | {_us(mine.get('median'))} | {_us(mine.get('p95'))} | "
+            f"{_us(theirs.get('median'))} | {_us(theirs.get('p95'))} |"
+        )
+    rtf = report.get("real_time_factor")
+    lines.append(
+        f"| real-time factor (whole loop) | {'-' if rtf is None else f'{rtf:.2f}'} | | "
+        f"{_rtf(other)} | |"
+    )
+    return "\n".join(lines)
+
+
+def _us(value: float | None) -> str:
+    return "-" if value is None else f"{1e6 * value:.1f}"
+
+
+def _rtf(other: dict) -> str:
+    value = other.get("real_time_factor")
+    return "-" if value is None else f"{value:.2f}"
+
+
+def add_bench_parser(sub: argparse._SubParsersAction) -> None:
+    """Add ``rsg bench`` to the subcommands."""
+    p = sub.add_parser(
+        "bench",
+        help="time the planner tick, the step QP, IK, physics and the whole loop",
+        description="Median and 95th percentile time per call of each part of the loop; "
+        "prints a table and writes bench.json.",
+    )
+    p.add_argument("--robot", default="g1", help="robot for the full-robot part (default g1)")
+    p.add_argument("--duration", type=float, default=4.0, help="full-robot walk [s] (4)")
+    p.add_argument("--samples", type=int, default=1000, help="sampled step QPs (1000)")
+    p.add_argument("--no-robot", action="store_true", help="skip the PyBullet part")
+    p.add_argument("--out", type=Path, required=True, help="folder for bench.json")
+
+
+def bench_command(args: argparse.Namespace) -> int:
+    """Run ``rsg bench``; returns 0."""
+    if not 0.05 <= args.duration <= 600.0:
+        raise ParameterError("--duration", args.duration, "seconds in [0.05, 600]")
+    if not 10 <= args.samples <= 1_000_000:
+        raise ParameterError("--samples", args.samples, "an integer in [10, 1000000]")
+    report: dict = {"units": "seconds per call; real_time_factor = simulated / wall time"}
+    report.update(bench_rsg_ticks())
+    report.update(bench_step_qp(args.samples))
+    if not args.no_robot:
+        report.update(bench_robot(args.robot, args.duration))
+        report["placo_wpg"] = bench_placo_wpg(args.robot, args.duration)
+    table = format_bench(report)
+    report["table"] = table
+    try:
+        args.out.mkdir(parents=True, exist_ok=True)
+        path = args.out / "bench.json"
+        path.write_text(json.dumps(report, indent=2) + "\n")
+    except OSError as exc:
+        raise RsgError(f"cannot write {args.out}/bench.json: {exc}") from exc
+    print(table)
+    print(
+        f"step QP: proxqp and exact agree within {QP_AGREEMENT:g} m on "
+        f"{100 * report['qp_agree_fraction']:.1f}% of {report['qp_samples']} sampled problems "
+        f"(largest difference {report['qp_max_difference']:.2e} m); the exact method's "
+        f"objective is {'never' if report['qp_exact_objective_not_worse'] else 'sometimes'} "
+        "worse than proxqp's"
+    )
+    print(f"wrote {path}")
+    return 0

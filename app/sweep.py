@@ -1,0 +1,426 @@
+"""``rsg sweep``: the largest recovered impulse per controller, direction and push phase.
+
+Jobs: one job is (controller, direction, phase). It bisects the impulse magnitude
+[N s] of a single push along the direction between 0 and ``bracket`` times the
+capturability bound (:mod:`app.capturability`) and returns the largest impulse that
+is still recovered, to ``tolerance``. Recovery is assumed monotone in the magnitude.
+
+Push phase: the LIPM walk starts in single support on the left foot at s~ = T_DSP,
+so nominal step k (k = 1, 2, ...) lands at t_k = T_SSP + (k - 1) T^*. Cycle k is
+[t_k, t_k + T^*) on the stance foot of step k (right for odd k). Phase p in [0, 1)
+puts the push start at t = t_k + p T^* of cycle ``cycle`` (default 3, right stance),
+i.e. at s~ = p T^* after the step; the run lasts ``settle`` seconds after that.
+
+Directions: n directions at angle 2 pi i / n in the world frame, 0 = forward (+x),
+90 deg = to the left (+y).
+
+Workers: jobs run in worker processes (``concurrent.futures``) or on a Ray cluster
+(``backend="ray"``, :mod:`app.sweep_ray`). Every finished job is appended to
+``jobs.jsonl`` in the output folder at once; a sweep started again on the same
+folder skips the jobs found there, so an interrupted sweep resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+import sys
+import time
+from collections.abc import Callable, Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from planner.exceptions import ParameterError, RsgError
+from planner.parameters import CONTROLLERS, PlannerConfig
+from planner.types import Push
+
+from .capturability import impulse_bound
+from .scenarios import Scenario
+
+PLACO_WPG = "placo-wpg"
+SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
+JOBS_FILE = "jobs.jsonl"
+SPEC_FILE = "sweep_spec.json"
+# Fields that change a job's result: a resumed sweep must agree on them.
+RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
+                 "qp_solver", "criterion", "fall_dcm_error")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """What to sweep.
+
+    Attributes:
+        model: ``lipm`` or ``pybullet``.
+        robot: Robot for ``pybullet``.
+        controllers: Controllers to compare.
+        directions: Number of push directions, evenly spaced.
+        phases: Push phases p in [0, 1) of the walking cycle.
+        duration: Push duration Delta [s].
+        cycle: Walking cycle (>= 1) in which the push starts.
+        settle: Simulated time after the push start [s].
+        tolerance: Bisection tolerance on the impulse [N s].
+        bracket: Upper end of the bisection, times the capturability bound [-].
+        qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
+        criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
+        fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
+            backend's own default (0.5 m) is a heuristic below the capturable DCM
+            error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
+            rule in effect (CoM within 0.6 m of the stance ankle) by default.
+    """
+
+    model: str = "lipm"
+    robot: str = "g1"
+    controllers: tuple[str, ...] = CONTROLLERS
+    directions: int = 16
+    phases: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
+    duration: float = 0.1
+    cycle: int = 3
+    settle: float = 6.0
+    tolerance: float = 0.25
+    bracket: float = 1.1
+    qp_solver: str = "exact"
+    criterion: str = "recovered"
+    fall_dcm_error: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.model not in ("lipm", "pybullet"):
+            raise ParameterError("model", self.model, "lipm or pybullet")
+        bad = [c for c in self.controllers if c not in SWEEP_CONTROLLERS]
+        if bad or not self.controllers or len(set(self.controllers)) != len(self.controllers):
+            raise ParameterError(
+                "controllers", ",".join(self.controllers), f"distinct of {SWEEP_CONTROLLERS}"
+            )
+        if PLACO_WPG in self.controllers:
+            from .placo_wpg import AVAILABLE, REASON
+
+            if not AVAILABLE:
+                raise ParameterError("controllers", PLACO_WPG, REASON)
+        if PLACO_WPG in self.controllers and self.model != "pybullet":
+            raise ParameterError(
+                "controllers",
+                PLACO_WPG,
+                "placo-wpg only with --model pybullet (it drives the full robot's IK; "
+                "on the LIPM it has no meaning)",
+            )
+        if not (isinstance(self.directions, int) and 1 <= self.directions <= 360):
+            raise ParameterError("directions", self.directions, "an integer in [1, 360]")
+        if not self.phases or not all(0.0 <= p < 1.0 for p in self.phases):
+            raise ParameterError("phases", self.phases, "fractions in [0, 1)")
+        checks = {
+            "duration": (self.duration, 1e-3, 1.0),
+            "settle": (self.settle, 1.0, 60.0),
+            "tolerance": (self.tolerance, 1e-3, 50.0),
+            "bracket": (self.bracket, 0.1, 10.0),
+            "fall_dcm_error": (self.fall_dcm_error, 0.05, 100.0),
+        }
+        for name, (value, low, high) in checks.items():
+            if not (math.isfinite(value) and low <= value <= high):
+                raise ParameterError(name, value, f"a number in [{low}, {high}]")
+        if not (isinstance(self.cycle, int) and 1 <= self.cycle <= 20):
+            raise ParameterError("cycle", self.cycle, "an integer in [1, 20]")
+        if self.qp_solver not in ("exact", "proxqp"):
+            raise ParameterError("qp_solver", self.qp_solver, "exact or proxqp")
+        if self.criterion not in ("recovered", "no-fall"):
+            raise ParameterError("criterion", self.criterion, "recovered or no-fall")
+
+    def angles(self) -> list[float]:
+        """Push directions [rad]."""
+        return [2.0 * math.pi * i / self.directions for i in range(self.directions)]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One bisection: controller, direction [rad] and phase [-]."""
+
+    controller: str
+    angle: float
+    phase: float
+
+    @property
+    def key(self) -> str:
+        return f"{self.controller}|{math.degrees(self.angle):.4f}|{self.phase:.4f}"
+
+
+@dataclass
+class Bisection:
+    """Result of :func:`bisect_threshold`: largest passing and smallest failing value."""
+
+    passed: float
+    failed: float | None
+    evaluations: list[tuple[float, bool]] = field(default_factory=list)
+
+
+def bisect_threshold(
+    predicate: Callable[[float], bool], upper: float, tolerance: float
+) -> Bisection:
+    """Largest x in [0, upper] with ``predicate(x)`` true, for a predicate monotone in x.
+
+    Evaluates ``upper`` first (if it passes, the answer is ``upper`` and ``failed`` is
+    None), then 0 (if it fails, the answer is 0), then bisects until the bracket is
+    narrower than ``tolerance``.
+    """
+    result = Bisection(0.0, upper)
+    for probe in (upper, 0.0):
+        ok = predicate(probe)
+        result.evaluations.append((probe, ok))
+        if ok and probe == upper:
+            return Bisection(upper, None, result.evaluations)
+        if not ok and probe == 0.0:
+            return Bisection(0.0, 0.0, result.evaluations)
+    low, high = 0.0, upper
+    while high - low > tolerance:
+        middle = 0.5 * (low + high)
+        ok = predicate(middle)
+        result.evaluations.append((middle, ok))
+        low, high = (middle, high) if ok else (low, middle)
+    return Bisection(low, high, result.evaluations)
+
+
+def push_timing(config: PlannerConfig, cycle: int, phase: float) -> tuple[float, int, float]:
+    """(push start [s], stance sigma, s~ [s]) for ``phase`` of walking cycle ``cycle``."""
+    gait = config.gait
+    step_time = gait.single_support_duration + (cycle - 1) * gait.step_duration
+    sigma = 1 if cycle % 2 == 0 else -1
+    since_step = phase * gait.step_duration
+    return step_time + since_step, sigma, since_step
+
+
+def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
+    if controller == PLACO_WPG:
+        from .placo_wpg import build_placo_wpg_backend
+
+        return build_placo_wpg_backend(spec.robot)
+    from .setup import build_backend
+
+    backend, config, initial = build_backend(spec.model, spec.robot, controller)
+    if spec.model == "lipm":
+        from .lipm_backend import LipmBackend
+
+        backend = LipmBackend(config.model, fall_dcm_error=spec.fall_dcm_error)
+    return backend, config, initial
+
+
+class SettledTrial:
+    """Recovery verdicts of one push time, each run from a snapshot taken before the push.
+
+    The walk up to the push is simulated once; each trial deep-copies that loop, adds
+    its push and runs on. The verdict is :attr:`RunResult.recovered` of the full run,
+    returned early: at a fall (False), or once the push is over, two nominal steps
+    have followed it and V_u < gamma_v at the second (True: from there the
+    undisturbed LIPM walks on nominally; a test checks the verdicts are equal).
+
+    Args:
+        backend, config, initial: As for :func:`app.runner.run_closed_loop`.
+        push_time: Start of the pushes to try [s].
+        end_time: Simulated time at which an unsettled run is judged [s].
+        qp_solver: ``exact`` or ``proxqp``.
+    """
+
+    def __init__(self, backend, config, initial, push_time: float, end_time: float,
+                 qp_solver: str = "exact") -> None:  # fmt: skip
+        from .runner import ClosedLoop
+
+        self.end_time = end_time
+        loop = ClosedLoop(backend, config, Scenario("sweep", end_time), initial, qp_solver)
+        for _ in range(int(math.floor(push_time / loop.period + 1e-9))):
+            loop.tick()
+        self.loop = copy.deepcopy(loop)  # independent of later uses of ``backend``
+
+    def recovered(self, push: Push) -> bool:
+        """Verdict for ``push`` (its time >= the snapshot's)."""
+        loop = copy.deepcopy(self.loop)
+        loop.add_push(push)
+        backend = loop.backend
+        push_end = push.time + push.duration
+        nominal_in_a_row = 0
+        while loop.ticks < int(round(self.end_time / loop.period)):
+            out = loop.tick()
+            if backend.fall_status().fell:
+                return False
+            if out.step is not None and out.time > push_end:
+                nominal_in_a_row = 0 if out.step.adjusted else nominal_in_a_row + 1
+                if nominal_in_a_row >= 2 and out.lyapunov < loop.generator.design.threshold:
+                    return True
+        return bool(loop.result().recovered)
+
+
+def run_job(spec: SweepSpec, job: Job) -> dict:
+    """Bisect one job; returns its JSON-ready record (what ``jobs.jsonl`` holds)."""
+    from .runner import run_closed_loop
+
+    started = time.perf_counter()
+    backend, config, initial = _build(spec, job.controller)
+    runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
+    early = spec.model == "lipm" and spec.criterion == "recovered"
+    try:
+        t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
+        bound = impulse_bound(config, job.angle, sigma, since, spec.duration)
+        direction = np.array([math.cos(job.angle), math.sin(job.angle)])
+        trial = None
+        if early:
+            trial = SettledTrial(
+                backend, config, initial, t_push, t_push + spec.settle, spec.qp_solver
+            )
+
+        def recovered(impulse: float) -> bool:
+            push = Push(t_push, impulse * direction, spec.duration)
+            scenario = Scenario("sweep", t_push + spec.settle, (push,))
+            if trial is not None:
+                return trial.recovered(push)
+            result = runner(backend, config, scenario, initial, qp_solver=spec.qp_solver)
+            if spec.criterion == "no-fall":
+                return not result.fall.fell
+            return bool(result.recovered)
+
+        found = bisect_threshold(recovered, spec.bracket * bound, spec.tolerance)
+    finally:
+        backend.close()
+    return {
+        "key": job.key,
+        "controller": job.controller,
+        "direction_deg": math.degrees(job.angle),
+        "phase": job.phase,
+        "push_time": t_push,
+        "stance": "left" if sigma > 0 else "right",
+        "impulse": found.passed,
+        "failed_at": found.failed,
+        "capped": found.failed is None,
+        "bound": bound,
+        "ratio": found.passed / bound if bound > 0 else math.nan,
+        "runs": len(found.evaluations),
+        "evaluations": found.evaluations,
+        "wall_time": time.perf_counter() - started,
+    }
+
+
+def _run_job_args(args: tuple[SweepSpec, Job]) -> dict:
+    return run_job(*args)
+
+
+class JobProgress:
+    """``done/total`` bar with elapsed time and estimate, on stderr."""
+
+    def __init__(self, total: int, done: int = 0, enabled: bool = True) -> None:
+        self.total, self.done, self.enabled = total, done, enabled
+        self.started = time.perf_counter()
+        self.new = 0
+        self.show()
+
+    def advance(self) -> None:
+        self.done += 1
+        self.new += 1
+        self.show()
+
+    def show(self) -> None:
+        if not self.enabled:
+            return
+        elapsed = time.perf_counter() - self.started
+        left = (self.total - self.done) * elapsed / self.new if self.new else math.nan
+        bar = "#" * int(25 * self.done / max(self.total, 1))
+        eta = f"~{left:.0f} s left" if math.isfinite(left) else ""
+        end = "\n" if self.done >= self.total else ""
+        sys.stderr.write(
+            f"\rsweep [{bar:<25}] {self.done}/{self.total} jobs {elapsed:.0f} s {eta:<16}{end}"
+        )
+        sys.stderr.flush()
+
+
+def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
+    """Jobs already finished in ``out`` (resume); checks the spec agrees.
+
+    Raises:
+        ParameterError: The folder holds a sweep with other result-defining settings.
+    """
+    spec_path = out / SPEC_FILE
+    if spec_path.is_file():
+        old = json.loads(spec_path.read_text())
+        for name in RESULT_FIELDS:
+            if old.get(name) != asdict(spec)[name]:
+                raise ParameterError(
+                    f"--out {out} ({name})",
+                    old.get(name),
+                    f"the same {name} as the sweep stored there ({asdict(spec)[name]!r}), "
+                    "or a new --out folder",
+                )
+    finished: dict[str, dict] = {}
+    jobs_path = out / JOBS_FILE
+    if jobs_path.is_file():
+        for line in jobs_path.read_text().splitlines():
+            try:
+                record = json.loads(line)
+            except json.JSONDecodeError:
+                continue  # a line cut by an interruption
+            finished[record["key"]] = record
+    return finished
+
+
+def all_jobs(spec: SweepSpec) -> list[Job]:
+    return [
+        Job(controller, angle, phase)
+        for controller in spec.controllers
+        for phase in spec.phases
+        for angle in spec.angles()
+    ]
+
+
+def run_sweep(
+    spec: SweepSpec,
+    out: Path,
+    workers: int = 1,
+    backend: str = "process",
+    progress: bool = True,
+) -> list[dict]:
+    """Run (or resume) the sweep into ``out``; returns the records of all its jobs.
+
+    Raises:
+        ParameterError: Bad workers/backend or a mismatching folder.
+        RsgError: The folder cannot be written.
+    """
+    if not (isinstance(workers, int) and 1 <= workers <= 1024):
+        raise ParameterError("--workers", workers, "an integer in [1, 1024]")
+    if backend not in ("process", "ray"):
+        raise ParameterError("--backend", backend, "process or ray")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        finished = load_finished(out, spec)
+        (out / SPEC_FILE).write_text(json.dumps(asdict(spec), indent=2) + "\n")
+    except OSError as exc:
+        raise RsgError(f"cannot write the sweep to {out}: {exc}") from exc
+    jobs = all_jobs(spec)
+    todo = [job for job in jobs if job.key not in finished]
+    bar = JobProgress(len(jobs), len(jobs) - len(todo), progress)
+    with (out / JOBS_FILE).open("a") as sink:
+        for record in _execute(spec, todo, workers, backend):
+            sink.write(json.dumps(record) + "\n")
+            sink.flush()
+            finished[record["key"]] = record
+            bar.advance()
+    return [finished[job.key] for job in jobs]
+
+
+def _execute(spec: SweepSpec, jobs: list[Job], workers: int, backend: str) -> Iterable[dict]:
+    if not jobs:
+        return
+    if backend == "ray":
+        from .sweep_ray import execute_on_ray
+
+        yield from execute_on_ray(spec, jobs, workers)
+        return
+    if workers == 1:
+        for job in jobs:
+            yield run_job(spec, job)
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = [pool.submit(_run_job_args, (spec, job)) for job in jobs]
+        try:
+            for future in as_completed(futures):
+                yield future.result()
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise

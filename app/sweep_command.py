@@ -1,0 +1,119 @@
+"""``rsg sweep``: command-line options and the command (see :mod:`app.sweep`)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from planner.exceptions import ParameterError
+from planner.parameters import CONTROLLERS
+
+from .envelope import build_envelope, format_table, write_envelope
+from .sweep import PLACO_WPG, SweepSpec, run_sweep
+from .sweep_plot import plot_envelope
+
+EPILOG = """\
+examples:
+  rsg sweep --model lipm --directions 16 --out results/sweep
+  rsg sweep --model lipm --controllers rsg,no-step --phases 0.5 --directions 8 --out /tmp/s
+  rsg sweep --model pybullet --controllers rsg,placo-wpg --directions 4 --phases 0.25 --out r
+  rsg sweep --backend ray --workers 64 --out results/sweep   # on a Ray cluster (RAY_ADDRESS)
+
+outputs in --out:
+  envelope.json, envelope.csv  largest recovered impulse and the bound per controller,
+                               direction and phase
+  envelope.png                 polar plot, one panel per phase
+  jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes
+"""
+
+
+def _csv(text: str) -> tuple[str, ...]:
+    return tuple(part.strip() for part in text.split(",") if part.strip())
+
+
+def _phases(text: str) -> tuple[float, ...]:
+    try:
+        return tuple(float(p) for p in _csv(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--phases={text!r}: fractions like 0,0.25,0.5") from None
+
+
+def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
+    """Add ``rsg sweep`` to the subcommands."""
+    p = sub.add_parser(
+        "sweep",
+        help="robustness map: largest recovered impulse per controller, direction and phase",
+        description="Bisect, for each controller, push direction and push phase, the largest "
+        "impulse that is still recovered, next to the LIPM's N-step capturability bound.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--model", choices=("lipm", "pybullet"), default="lipm")
+    p.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    p.add_argument(
+        "--controllers",
+        type=_csv,
+        default=None,
+        help=f"comma-separated, of {', '.join((*CONTROLLERS, PLACO_WPG))} (default: all that "
+        "fit the model; placo-wpg needs --model pybullet)",
+    )
+    p.add_argument("--directions", type=int, default=16, help="push directions (default 16)")
+    p.add_argument(
+        "--phases",
+        type=_phases,
+        default=(0.0, 0.25, 0.5, 0.75),
+        help="push phases, fractions of the walking cycle (default 0,0.25,0.5,0.75)",
+    )
+    p.add_argument("--duration", type=float, default=0.1, help="push duration [s] (0.1)")
+    p.add_argument("--cycle", type=int, default=3, help="walking cycle of the push (3)")
+    p.add_argument("--settle", type=float, default=6.0, help="time after the push [s] (6)")
+    p.add_argument("--tolerance", type=float, default=0.25, help="bisection [N s] (0.25)")
+    p.add_argument("--criterion", choices=("recovered", "no-fall"), default=None,
+                   help="recovered (lipm default) or no-fall (pybullet default)")  # fmt: skip
+    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
+    p.add_argument("--backend", choices=("process", "ray"), default="process",
+                   help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
+    p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def sweep_command(args: argparse.Namespace) -> int:
+    """Run ``rsg sweep``; returns 0."""
+    controllers = args.controllers
+    if controllers is None:
+        from .placo_wpg import AVAILABLE
+
+        with_wpg = args.model == "pybullet" and AVAILABLE
+        controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
+    elif PLACO_WPG in controllers and args.model == "lipm":
+        raise ParameterError(
+            "--controllers", PLACO_WPG, "controllers without placo-wpg on --model lipm "
+            "(placo-wpg drives the full robot's IK: use --model pybullet)"
+        )  # fmt: skip
+    criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
+    spec = SweepSpec(
+        model=args.model,
+        robot=args.robot,
+        controllers=tuple(controllers),
+        directions=args.directions,
+        phases=args.phases,
+        duration=args.duration,
+        cycle=args.cycle,
+        settle=args.settle,
+        tolerance=args.tolerance,
+        criterion=criterion,
+    )
+    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    started = time.perf_counter()
+    records = run_sweep(spec, args.out, workers, args.backend, progress=not args.quiet)
+    envelope = build_envelope(spec, records)
+    envelope["wall_time"] = time.perf_counter() - started
+    paths = write_envelope(args.out, envelope)
+    paths.append(plot_envelope(envelope, args.out / "envelope.png"))
+    for path in paths:
+        print(f"wrote {path}")
+    print(format_table(envelope))
+    print(f"sweep: {len(records)} jobs, {envelope['wall_time']:.0f} s wall time")
+    return 0

@@ -1,0 +1,42 @@
+"""rsg bench: statistics, the timing wrapper, the step QP comparison and the table."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from app.bench import bench_rsg_ticks, bench_step_qp, format_bench, stats, timed
+from app.cli import main
+
+
+def test_stats_and_wrapper() -> None:
+    summary = stats([float(v) for v in range(1, 101)])
+    assert summary["median"] == pytest.approx(50.5)
+    assert summary["p95"] == pytest.approx(95.05)
+    assert stats([])["count"] == 0
+    sink: list[float] = []
+    double = timed(lambda x: 2 * x, sink)
+    assert double(3) == 6 and len(sink) == 1 and sink[0] >= 0.0
+
+
+def test_step_qp_methods_agree_and_exact_is_optimal() -> None:
+    report = bench_step_qp(samples=200)
+    assert report["qp_proxqp"]["count"] == 200 == report["qp_exact"]["count"]
+    assert report["qp_exact_objective_not_worse"]
+    assert report["qp_agree_fraction"] > 0.95
+
+
+def test_rsg_ticks_split_flow_and_jumps() -> None:
+    report = bench_rsg_ticks(duration=2.0)
+    assert report["rsg_tick"]["count"] + report["rsg_step_tick"]["count"] == 2000
+    assert report["rsg_step_tick"]["count"] == 2  # nominal steps at 0.7 s and 1.5 s
+
+
+def test_bench_command_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+    assert main(["bench", "--no-robot", "--samples", "50", "--out", str(tmp_path)]) == 0
+    report = json.loads((tmp_path / "bench.json").read_text())
+    assert report["qp_exact"]["count"] == 50
+    assert "planner tick" in capsys.readouterr().out
+    assert "| IK solve |" in format_bench(report)
