@@ -1,10 +1,18 @@
-"""The ``rsg`` command line: ``rsg run`` (and later ``demo``, ``sweep``, ``bench``)."""
+"""The ``rsg`` command line: ``rsg run``, ``rsg sweep``, ``rsg bench`` and plug-in commands.
+
+Packages that sit above ``app`` (the browser demo in ``web``) add their commands
+through the entry-point group ``rsg.commands`` (see pyproject.toml): each entry is a
+module with ``add_parser(subparsers)`` and ``run(args) -> int``. So ``app`` never
+imports ``web``; ``web`` depends on ``app``.
+"""
 
 from __future__ import annotations
 
 import argparse
+import importlib.metadata
 import sys
 from pathlib import Path
+from typing import Any
 
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
@@ -42,6 +50,17 @@ def _positive_seconds(text: str) -> float:
     if not 0.0 < value <= 3600.0:
         raise argparse.ArgumentTypeError(f"--duration={value}: expected seconds in (0, 3600]")
     return value
+
+
+PLUGIN_GROUP = "rsg.commands"
+
+
+def plugin_commands() -> dict[str, Any]:
+    """Commands registered by other packages in the entry-point group ``rsg.commands``."""
+    commands = {}
+    for entry in importlib.metadata.entry_points(group=PLUGIN_GROUP):
+        commands[entry.name] = entry.load()
+    return commands
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -95,9 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, required=True, help="folder for the results")
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
-    from web.cli_demo import add_demo_parser
-
-    add_demo_parser(sub)
+    for command in plugin_commands().values():
+        command.add_parser(sub)
     from .bench import add_bench_parser
     from .sweep_command import add_sweep_parser
 
@@ -115,10 +133,9 @@ def main(argv: list[str] | None = None) -> int:
             from .run_command import run_command
 
             return run_command(args)
-        if args.command == "demo":
-            from web.demo import main as demo_main
-
-            return demo_main(args)
+        plugins = plugin_commands()
+        if args.command in plugins:
+            return int(plugins[args.command].run(args))
         if args.command == "sweep":
             from .sweep_command import sweep_command
 

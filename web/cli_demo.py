@@ -1,4 +1,7 @@
-"""The ``rsg demo`` subcommand's arguments (the command itself is :func:`web.demo.main`)."""
+"""The ``rsg demo`` subcommand, registered in the entry-point group ``rsg.commands``.
+
+``add_parser`` adds its arguments to ``rsg``; ``run`` starts :func:`web.demo.main`.
+"""
 
 from __future__ import annotations
 
@@ -61,3 +64,15 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     )
     demo.add_argument("--port", type=_port, default=8080, help="port to serve on (default: 8080)")
     return demo
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Entry-point hook: add ``demo`` to ``rsg``."""
+    return add_demo_parser(sub)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry-point hook: run ``rsg demo``."""
+    from web.demo import main
+
+    return int(main(args))
