@@ -35,6 +35,15 @@ def _push_marks(result: RunResult) -> list[int]:
     return [int(np.searchsorted(t, p.time)) for p in result.scenario.pushes if p.time <= t[-1]]
 
 
+def _mark_pushes_and_adjusted_steps(ax: plt.Axes, result: RunResult) -> None:
+    """Shade each push's interval and draw a red line at each adjusted step."""
+    for push in result.scenario.pushes:
+        ax.axvspan(push.time, push.time + push.duration, color="lime", alpha=0.4)
+    for step in result.steps:
+        if step.event["adjusted"]:
+            ax.axvline(step.event["t"], color=ADJUSTED_COLOR, lw=0.8)
+
+
 def plot_top_view(result: RunResult, path: Path) -> None:
     cons = result.config.constraints
     fig, ax = plt.subplots(figsize=(11, 5))
@@ -95,11 +104,7 @@ def plot_time_since_step(result: RunResult, path: Path) -> None:
         lw=1,
         label="T_DSP + T_SP (earliest)",
     )
-    for p in result.scenario.pushes:
-        ax.axvspan(p.time, p.time + p.duration, color="lime", alpha=0.4)
-    for s in result.steps:
-        if s.event["adjusted"]:
-            ax.axvline(s.event["t"], color=ADJUSTED_COLOR, lw=0.8)
+    _mark_pushes_and_adjusted_steps(ax, result)
     ax.set_xlabel("t [s]")
     ax.set_ylabel("s~ = t - s_{j-1} [s]")
     ax.legend(loc="upper right", fontsize=8)
@@ -137,11 +142,7 @@ def plot_dcm_error(result: RunResult, path: Path) -> None:
     t = result.column("t")
     bx.semilogy(t, np.maximum(result.column("lyapunov"), 1e-9), color="tab:blue", label="V_u(t)")
     bx.axhline(gamma, color="black", lw=1.5, label="gamma_v")
-    for p in result.scenario.pushes:
-        bx.axvspan(p.time, p.time + p.duration, color="lime", alpha=0.4)
-    for s in result.steps:
-        if s.event["adjusted"]:
-            bx.axvline(s.event["t"], color=ADJUSTED_COLOR, lw=0.8)
+    _mark_pushes_and_adjusted_steps(bx, result)
     bx.set_xlabel("t [s]")
     bx.set_ylabel("V_u")
     bx.legend(loc="upper right", fontsize=8)

@@ -30,6 +30,7 @@ from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
 
 from .scene_model import ControllerState, PushInput, StepMark, Trail
+from .worker import Worker
 
 Array = NDArray[np.float64]
 
@@ -173,8 +174,7 @@ class LiveSimulation:
         self._log = log or _print_line
         self._scenario_source: Scenario = load_scenario(scenario)
         self._requests: queue.Queue[tuple[str, object]] = queue.Queue()
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker = Worker(self._run, "rsg-live-sim")
         self._serial = 0
         self._paused = False
         self._slow_motion = 1.0
@@ -194,16 +194,11 @@ class LiveSimulation:
 
     def start(self) -> None:
         """Start the simulation thread (idempotent)."""
-        if self._thread is None:
-            self._thread = threading.Thread(target=self._run, name="rsg-live-sim", daemon=True)
-            self._thread.start()
+        self._worker.start()
 
     def stop(self, timeout: float = 5.0) -> None:
         """Stop the thread and release the backend."""
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
+        self._worker.stop(timeout)
         if self._loop is not None:
             self._loop.backend.close()
 
@@ -279,11 +274,11 @@ class LiveSimulation:
         return self._loop
 
     # ----------------------------------------------------------------- the thread
-    def _run(self) -> None:
+    def _run(self, stop: threading.Event) -> None:
         anchor_wall, anchor_sim = wallclock.perf_counter(), self._require_loop().time
         speed_wall, speed_sim = anchor_wall, anchor_sim
         last_publish = 0.0
-        while not self._stop.is_set():
+        while not stop.is_set():
             if self._handle_requests():
                 anchor_wall, anchor_sim = wallclock.perf_counter(), self._require_loop().time
                 speed_wall, speed_sim = anchor_wall, anchor_sim
@@ -292,7 +287,7 @@ class LiveSimulation:
             if not self._running():
                 self._speed = 0.0
                 self._publish()
-                self._stop.wait(0.02)
+                stop.wait(0.02)
                 anchor_wall, anchor_sim = wallclock.perf_counter(), loop.time
                 speed_wall, speed_sim = anchor_wall, anchor_sim
                 continue
@@ -317,7 +312,7 @@ class LiveSimulation:
                 last_publish = now
             wait = (loop.time + loop.period - target) / self._slow_motion
             if wait > 0.0:
-                self._stop.wait(min(wait, PUBLISH_PERIOD))
+                stop.wait(min(wait, PUBLISH_PERIOD))
 
     def _running(self) -> bool:
         return not (

@@ -54,6 +54,7 @@ from .scene_model import (
     push_arrow,
     ray_ground_intersection,
 )
+from .worker import Worker
 
 Array = NDArray[np.float64]
 
@@ -112,8 +113,7 @@ class DemoPage:
         self.server = server
         self._log = log or (lambda line: print(line, flush=True))
         self.live = live
-        self._stop = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._worker = Worker(self._run, "rsg-page")
         self._offset = np.zeros(2)
         self._last_serial = -1
         self._last_plot = 0.0
@@ -335,21 +335,16 @@ class DemoPage:
     # ---------------------------------------------------------------- render thread
     def start(self) -> None:
         """Start updating the page (idempotent)."""
-        if self._thread is None:
-            self._thread = threading.Thread(target=self._run, name="rsg-page", daemon=True)
-            self._thread.start()
+        self._worker.start()
 
     def stop(self, timeout: float = 5.0) -> None:
         """Stop updating the page."""
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
+        self._worker.stop(timeout)
 
-    def _run(self) -> None:
+    def _run(self, stop: threading.Event) -> None:
         period = 1.0 / FRAME_RATE
         last = wallclock.perf_counter()
-        while not self._stop.is_set():
+        while not stop.is_set():
             start = wallclock.perf_counter()
             snap = self.live.snapshot()
             if snap.serial != self._last_serial or self._dirty:
@@ -362,7 +357,7 @@ class DemoPage:
                 last = start
                 self._frames = [t for t in self._frames if t > start - 1.0] + [start]
                 self.update_rate = float(len(self._frames))
-            self._stop.wait(max(0.0, period - (wallclock.perf_counter() - start)))
+            stop.wait(max(0.0, period - (wallclock.perf_counter() - start)))
 
     def update(self, snap: Snapshot, dt: float) -> None:
         """Show ``snap`` (one atomic scene update; plots at :data:`PLOT_RATE`)."""
