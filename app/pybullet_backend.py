@@ -13,12 +13,55 @@ Each control tick (``control_period``, several 1 ms physics steps):
 2. Feet: the stance sole is put flat at ``command.stance.position``; the swing
    sole follows :class:`SwingFootTrajectory` toward ``command.next_step.position``
    with the planner's timing: touchdown ``touchdown_lead`` before
-   ``command.next_step_time`` (absolute [s], re-planned every tick). The planner's jump (``command.step``) happens at its planned time: the
-   swing foot becomes the stance foot at the step position at once.
+   ``command.next_step_time`` (absolute [s], re-planned every tick). The
+   planner's jump (``command.step``) happens at its planned time: the swing foot
+   becomes the stance foot at the step position at once, and the old stance foot
+   is raised by ``transfer_lift`` for the rest of the double support.
 3. Whole-body IK (placo) -> joint position targets (velocity feed-forward from
    the difference of successive solutions) -> PyBullet POSITION_CONTROL.
 4. Physics steps, the push force being applied on the pelvis at every step.
 5. Measurement: whole-body CoM and its velocity from the link states.
+
+Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
+
+* Weight transfer. The joints track the IK to < 0.5 deg, so in double support the
+  load split between the feet is set by sub-millimetre errors: a foot commanded
+  exactly onto the ground touches but carries nothing. Landing at the planner's
+  step left the CoP on the old foot for ~50 ms while the plan (``"full"``: the
+  planner's hdot compensation puts the effective ZMP on the new foot at the step)
+  already decelerated the CoM: 3-4 cm of DCM error per step. Landing earlier
+  (``touchdown_lead``) or pressing the landing foot into the ground
+  (``touchdown_depth``) loads it BEFORE the step while the plan still has the
+  ZMP on the old foot, and makes the robot hop. Raising the old foot by 3 mm
+  right after the step (``transfer_lift``) moves the weight at the step, as the
+  planner's model assumes: DCM error through the first double support < 1 cm.
+* Angular momentum of the motion. The measured CoP is the LIPM's
+  c - c''/omega^2 plus S Ldot/(m g), where Ldot is the centroidal angular
+  momentum rate of the IK motion itself (``WholeBodyIK.angular_momentum``, the
+  legs and the torso: up to 15 N m at swing lift-off, i.e. a 4-5 cm CoP shift,
+  predicted by the IK model to within a few mm). With a CoM plan that ignores it
+  the CoP leaves the sole and the stance foot rolls over its edge.
+  ``momentum_compensation`` integrates the CoM plan with that Ldot and with the
+  CoP that keeps the commanded pivot (ZMP - S hdot/(m g)), clipped to the stance
+  sole (minus ``cop_margin``): the CoP stays on the sole, and only what the sole
+  cannot take moves the CoM away from the planner's LIPM (the planner sees it as
+  DCM error and corrects it). The clip also handles the planner's own double
+  support: its compensation m g H^-1 r~ is low-pass filtered (theta = 0.05 s),
+  so its effective pivot starts at the old foot and overshoots the new sole by
+  up to 8 cm at the end of the double support.
+* Touchdown timing. The planner detects its jump at the first tick after the
+  predicted ``next_step_time`` (nominal steps come every 0.82 s, not 0.8 s), and a
+  sole landing with zero vertical speed is within 1 mm of the ground for its last
+  ~40 ms. A foot that touches before the jump takes the whole weight at once
+  (the stance foot's force drops to 0): 2-3 cm of DCM error at the 2nd and 3rd
+  steps of a nominal walk. ``landing_delay`` (one tick) and ``touchdown_speed``
+  address it; they help the ``no-step`` walk (3.1 s -> 4.7 s), as does
+  ``smooth_swing`` (minimum-jerk swing, smaller Ldot at lift-off: 3.1 s -> 5.2 s),
+  but not the RSG (4.0-4.6 s against 5.7 s), so they are off by default.
+* Remaining limitation: the RSG's threshold gamma_v corresponds to a DCM error of
+  ~1.1 cm on G1 (window 2 cm / gain 1.85). Errors of 1-2 cm (touchdown, CoP
+  clipped at the sole's edge, swing re-timing) keep triggering timing and location
+  adjustments; the walk then drifts laterally and falls after ~5-6 s.
 """
 
 from __future__ import annotations
@@ -29,11 +72,12 @@ from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 from app.backend import FallStatus, InitialCondition
 from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
-from kinematics.com_plan import lipm_integrate
+from kinematics.com_plan import GRAVITY, ROTATION_90, lipm_integrate
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
@@ -71,6 +115,14 @@ class PyBulletBackend:
         touchdown_lead: float = 0.0,
         touchdown_depth: float = 0.0,
         plan_angular_momentum: str = "full",
+        transfer_lift: float = 0.0,
+        transfer_ramp: float = 0.02,
+        momentum_compensation: float = 0.0,
+        momentum_filter: float = 0.02,
+        cop_margin: float = 0.01,
+        touchdown_speed: float = 0.0,
+        landing_delay: float = 0.0,
+        smooth_swing: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -104,6 +156,22 @@ class PyBulletBackend:
                 (without it: the plan's ZMP moves along the moving window from the
                 old foot to the new one over T_DSP, as the feet can realise) or
                 ``"none"``.
+            transfer_lift: After the planner's step, the old stance foot is raised
+                this far [m] (ramped over ``transfer_ramp`` [s]) for the rest of
+                the double support, so the weight moves onto the new foot at once.
+            transfer_ramp: Duration of that ramp [s].
+            momentum_compensation: Fraction [-] of the IK motion's own centroidal
+                angular momentum rate taken into the CoM plan (see the module notes).
+            momentum_filter: Time constant of the low-pass filter on that rate [s].
+            touchdown_speed: Vertical speed of the swing sole at touchdown [m/s]
+                (a foot landing at zero speed skims the ground, within 1 mm, for
+                its last ~40 ms).
+            smooth_swing: Minimum-jerk horizontal swing (zero acceleration at
+                lift-off) instead of the cubic.
+            landing_delay: Time the touchdown this long after the planner's
+                predicted step time [s] (its jump comes one control tick after it).
+            cop_margin: Distance [m] kept between the CoP the CoM plan asks for and
+                the edges of the stance sole when ``momentum_compensation`` > 0.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -132,6 +200,27 @@ class PyBulletBackend:
             )
         self.plan_angular_momentum = plan_angular_momentum
         self.touchdown_depth = touchdown_depth
+        if not (0.0 <= transfer_lift <= 0.02 and transfer_ramp > 0.0):
+            raise ParameterError(
+                "transfer_lift/transfer_ramp",
+                (transfer_lift, transfer_ramp),
+                "lift in [0, 0.02] m and ramp > 0 s",
+            )
+        if not (0.0 <= momentum_compensation <= 1.0 and momentum_filter > 0.0):
+            raise ParameterError(
+                "momentum_compensation/momentum_filter",
+                (momentum_compensation, momentum_filter),
+                "compensation in [0, 1] and filter > 0 s",
+            )
+        if not 0.0 <= cop_margin < self.description.sole.half_width:
+            raise ParameterError("cop_margin", cop_margin, "in [0, sole half width) m")
+        self.transfer_lift = transfer_lift
+        self.transfer_ramp = transfer_ramp
+        self.momentum_compensation = momentum_compensation
+        self.momentum_filter = momentum_filter
+        self.cop_margin = cop_margin
+        self._ik_momentum: NDArray[np.float64] | None = None
+        self._ik_momentum_rate = np.zeros(2)
         self._com_reference = np.zeros(2)
         self._com_velocity_reference = np.zeros(2)
         self.timing = timing or SwingTiming()
@@ -141,8 +230,16 @@ class PyBulletBackend:
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
         self.swing = SwingFootTrajectory(
-            self.timing, apex_height=self.description.swing_height, arrival_lead=arrival_lead
+            self.timing,
+            apex_height=self.description.swing_height,
+            arrival_lead=arrival_lead,
+            touchdown_speed=touchdown_speed,
+            smooth_horizontal=smooth_swing,
         )
+        if not 0.0 <= landing_delay <= 0.05:
+            raise ParameterError("landing_delay", landing_delay, "in [0, 0.05] s")
+        self.landing_delay = landing_delay
+
         self.timers: dict[str, float] = defaultdict(float)
         self.ticks = 0
         self._stance: Foot = "left"
@@ -193,6 +290,8 @@ class PyBulletBackend:
         self._measured = self._measure()
         self._com_reference = com_xy.copy()
         self._com_velocity_reference = com_velocity.copy()
+        self._ik_momentum = None
+        self._ik_momentum_rate = np.zeros(2)
         return self._measured
 
     def _ik_reset(
@@ -216,21 +315,44 @@ class PyBulletBackend:
             self._stance = stance
         com_target = self._advance_com_reference(command)
         time_since_step = command.time_since_step + dt
-        # Touchdown a little before the planner's step so the foot carries load
-        # when the stance switches (measured: landing exactly at the switch leaves
-        # the CoP on the old foot for ~30 ms and costs ~2 cm of DCM error).
+        # Optional touchdown before the planner's step (``touchdown_lead``); G1
+        # uses 0 and unloads the old foot after the step instead (transfer_lift).
+        # The planner detects its jump at the first tick after the predicted step
+        # time (measured: one tick after ``next_step_time`` in nominal walking), so
+        # the foot is timed to touch down then and not earlier: a foot that
+        # touches before the jump takes the whole weight while the plan still
+        # has the ZMP on the stance foot (2-3 cm of DCM error).
         landing = (
-            command.next_step_time - (command.time - command.time_since_step)
-        ) - self.touchdown_lead
+            command.next_step_time
+            - (command.time - command.time_since_step)
+            + self.landing_delay
+            - self.touchdown_lead
+        )
         swing_position = self.swing.update(time_since_step, command.next_step.position, dt, landing)
         swing_position[2] = max(swing_position[2] - self._press_depth(swing_position), -0.01)
+        if self.transfer_lift > 0.0 and time_since_step < self.timing.double_support + 0.1:
+            # The old stance foot leaves the ground at the step: the new one takes
+            # the weight at once (kept until the swing profile rises above it).
+            # Measured: keeping both feet down until the plan's pivot reaches the
+            # new sole leaves the CoP on the old foot (4-5 cm of DCM error).
+            lift = self.transfer_lift * min(time_since_step / self.transfer_ramp, 1.0)
+            swing_position[2] = max(swing_position[2], lift)
         soles = {
             stance: _ground_pose(command.stance.position),
             swing_foot: sole_pose(swing_position),
         }
+
         support = "both" if command.double_support else stance
         planned = clock.perf_counter()
         q = self.ik.solve(com_target, soles["left"], soles["right"], support, dt)[self._ik_to_sim]
+        # Rate of the IK motion's own centroidal angular momentum (low-pass).
+        momentum = self.ik.angular_momentum[:2].copy()
+        previous_momentum = momentum if self._ik_momentum is None else self._ik_momentum
+        rate = (momentum - previous_momentum) / dt
+        self._ik_momentum = momentum
+        self._ik_momentum_rate += min(dt / self.momentum_filter, 1.0) * (
+            rate - self._ik_momentum_rate
+        )
         solved = clock.perf_counter()
         previous = self._joint_targets
         velocity = (q - previous) / dt
@@ -274,10 +396,13 @@ class PyBulletBackend:
             "feedback": command.angular_momentum_rate_feedback,
             "none": np.zeros(2),
         }[self.plan_angular_momentum]
+        zmp = np.asarray(command.zmp, float)
+        if self.momentum_compensation > 0.0:
+            zmp, hdot = self._momentum_aware_pivot(command, zmp, hdot)
         self._com_reference, self._com_velocity_reference = lipm_integrate(
             self._com_reference,
             self._com_velocity_reference,
-            command.zmp,
+            zmp,
             hdot,
             self.mass,
             self.com_height,
@@ -288,13 +413,45 @@ class PyBulletBackend:
         target, _ = lipm_integrate(
             self._com_reference,
             self._com_velocity_reference,
-            command.zmp,
+            zmp,
             hdot,
             self.mass,
             self.com_height,
             self.com_lookahead,
         )
         return target + correction
+
+    def _momentum_aware_pivot(
+        self, command: PlannerOutput, zmp: NDArray[np.float64], hdot: NDArray[np.float64]
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """ZMP and hdot of the CoM plan given the IK motion's own angular momentum rate.
+
+        The CoP that keeps the commanded pivot (ZMP - S hdot / (m g)) while the
+        motion produces Ldot is pivot + S Ldot / (m g); it is clipped to the stance
+        sole (both soles in a double support with a ramped plan). The CoM plan then
+        uses that CoP as its ZMP and Ldot as its hdot.
+        """
+        weight = self.mass * GRAVITY
+        pivot = zmp - ROTATION_90 @ hdot / weight
+        rate = self.momentum_compensation * self._ik_momentum_rate
+        wanted = pivot + ROTATION_90 @ rate / weight
+        sole = self.description.sole
+        margin = self.cop_margin
+        stance = np.asarray(command.stance.position, float)
+        low = stance + np.array([sole.x_min + margin, -sole.half_width + margin])
+        high = stance + np.array([sole.x_max - margin, sole.half_width - margin])
+        if command.double_support and self.plan_angular_momentum != "full":
+            old = np.asarray(command.previous_stance.position, float)
+            corners = np.array(
+                [
+                    foot + np.array([x, y])
+                    for foot in (stance, old)
+                    for x in (sole.x_min + margin, sole.x_max - margin)
+                    for y in (-sole.half_width + margin, sole.half_width - margin)
+                ]
+            )
+            return _clip_to_hull(wanted, corners), rate
+        return np.clip(wanted, low, high), rate
 
     def _measure(self) -> MeasuredState:
         com, com_velocity = self.sim.com_state()
@@ -339,6 +496,23 @@ class PyBulletBackend:
     def close(self) -> None:
         """Release the PyBullet client."""
         self.sim.close()
+
+
+def _clip_to_hull(point: NDArray[np.float64], corners: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``point`` if inside the convex hull of ``corners`` (n x 2), else its nearest hull point."""
+    hull = ConvexHull(corners)
+    if np.all(hull.equations[:, :2] @ point + hull.equations[:, 2] <= 1e-12):
+        return point
+    best, best_distance = point, np.inf
+    for start, end in hull.simplices:
+        a, b = corners[start], corners[end]
+        edge = b - a
+        fraction = float(np.clip((point - a) @ edge / (edge @ edge), 0.0, 1.0))
+        candidate = a + fraction * edge
+        distance = float(np.linalg.norm(point - candidate))
+        if distance < best_distance:
+            best, best_distance = candidate, distance
+    return best
 
 
 def _ground_pose(position_xy: NDArray[np.float64]) -> NDArray[np.float64]:

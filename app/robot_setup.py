@@ -49,6 +49,7 @@ def planner_config_for(
             lqr_dcm_error_scale=description.lqr_dcm_error_scale,
             lqr_zmp_scale=half_width,
             lqr_angular_momentum_scale=description.angular_momentum_rate_max,
+            swing_preparation_time=description.swing_preparation_time,
         ),
         controller=controller,
     )

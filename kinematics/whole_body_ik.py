@@ -12,6 +12,10 @@ of the simulation and moves it, once per control tick, so that:
   so the upper body realises the planner's rate of change of angular momentum.
 
 Its output is the joint target vector for the simulator's position control.
+After each solve, :attr:`WholeBodyIK.angular_momentum` holds the centroidal
+angular momentum of the motion from the previous solution to this one [N m s]
+(the backend's CoM plan accounts for its rate: on G1 it shifts the CoP by up to
+4-5 cm at swing lift-off).
 The model is never reset from measurements: the closed loop goes through the CoM
 target, which the caller computes from the measured state.
 """
@@ -22,6 +26,7 @@ import xml.etree.ElementTree as ET
 from typing import Literal
 
 import numpy as np
+import pinocchio
 import placo
 from numpy.typing import NDArray
 
@@ -68,6 +73,8 @@ class WholeBodyIK:
     Attributes:
         joint_names: Actuated joint names, in the order of :meth:`solve`'s output.
         robot: The placo model (its state is the last IK solution).
+        angular_momentum: Centroidal angular momentum [N m s], shape (3,), of the
+            motion of the last :meth:`solve` (finite difference over its ``dt``).
     """
 
     def __init__(self, description: RobotDescription, use_angular_momentum: bool = False) -> None:
@@ -110,6 +117,8 @@ class WholeBodyIK:
             self.momentum_task.mask.set_axises("xy")
             self.momentum_task.configure("angular_momentum", "soft", MOMENTUM_WEIGHT)
         self._support: Support | None = None
+        self._previous_q: NDArray[np.float64] | None = None
+        self.angular_momentum = np.zeros(3)
 
     def standing_posture(self) -> dict[str, float]:
         """Joint name -> standing angle [rad] for every actuated joint."""
@@ -152,6 +161,7 @@ class WholeBodyIK:
         for foot, task in self.foot_tasks.items():
             task.configure(f"{foot}_foot", "soft", FOOT_WEIGHT, FOOT_WEIGHT)
         self._support = None
+        self.angular_momentum = np.zeros(3)
         self.solver.dt = 0.01
         for _ in range(iterations):
             self._set_targets(com_xy, left_sole, right_sole, None)
@@ -212,8 +222,11 @@ class WholeBodyIK:
         self._configure_support(support)
         self.solver.dt = dt
         self._set_targets(com_xy, left_sole, right_sole, angular_momentum)
+        previous = np.array(self.robot.state.q, dtype=float)
         self.solver.solve(True)
         self.robot.update_kinematics()
+        velocity = pinocchio.difference(self.robot.model, previous, self.robot.state.q) / dt
+        self.angular_momentum = (np.asarray(self.robot.centroidal_map()) @ velocity)[3:6]
         return self.joint_angles()
 
     def joint_angles(self) -> NDArray[np.float64]:

@@ -97,6 +97,8 @@ class RobotDescription:
         step_max: Upper bound u_d^M of a step (x, y) [m].
         angular_momentum_rate_max: Bound on the feedback hdot [N m].
         lqr_dcm_error_scale: DCM error scale e_max of the LQR (Bryson) [m].
+        swing_preparation_time: T_SP, time the swing foot needs after the double
+            support before it can land [s] (bounds how early the planner may step).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         backend_options: Keyword arguments of the PyBullet backend tuned for
@@ -129,6 +131,7 @@ class RobotDescription:
     step_max: tuple[float, float] = (0.35, 0.4)
     angular_momentum_rate_max: float = 3.0
     lqr_dcm_error_scale: float = 0.03
+    swing_preparation_time: float = 0.2
     sole_box_collision: bool = False
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 

@@ -4,6 +4,19 @@ Measured facts: 33.3 kg; each foot touches the ground only through four 5 mm
 spheres centred 30 mm below ``*_ankle_roll_link`` at x in {-0.05, 0.12} m and
 y in {+-0.025, +-0.03} m (about 17 x 6 cm); four links have no ``<inertial>``
 (the IMU and camera frames), fixed in the derived URDF.
+
+Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
+
+* ``swing_preparation_time`` T_SP = 0.5 s instead of the planner's 0.2 s: a swing
+  that must land 0.2 s after lift-off moves the 7 kg legs fast enough that their
+  angular momentum rate (up to ~15 N m) shifts the CoP by 4-5 cm, more than the
+  whole sole, and every early step then causes the next one.
+* ``transfer_lift`` 3 mm: at the planner's step the old foot is raised so the new
+  foot carries the weight at once, as the planner's reference model assumes
+  (landing without it leaves the CoP on the old foot for ~50 ms: 3-4 cm of DCM
+  error per step).
+* ``momentum_compensation`` 1: the CoM plan accounts for the angular momentum of
+  the IK motion itself, keeping the CoP inside the 5 cm wide sole.
 """
 
 from __future__ import annotations
@@ -77,10 +90,13 @@ G1 = RobotDescription(
     fall_base_height=0.45,
     swing_height=0.06,
     sole_box_collision=True,
+    swing_preparation_time=0.5,
     backend_options={
         "com_reference_blend": 0.05,
         "com_tracking_gains": (1.0, 0.0),
-        "touchdown_lead": 0.05,
-        "touchdown_depth": 0.005,
+        "transfer_lift": 0.003,
+        "momentum_compensation": 1.0,
+        "momentum_filter": 0.05,
+        "cop_margin": 0.0,
     },
 )

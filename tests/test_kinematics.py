@@ -41,6 +41,21 @@ def test_ik_moves_the_swing_foot_in_single_support(ik):
     assert np.linalg.norm(ik.sole_world("left")[:3, 3] - left[:3, 3]) < 1e-4
 
 
+def test_ik_reports_the_angular_momentum_of_its_own_motion(ik):
+    left, right = sole_pose([0.0, 0.115, 0.0]), sole_pose([0.0, -0.115, 0.0])
+    ik.reset(left, right, np.array([0.0, 0.1]))
+    for _ in range(5):
+        ik.solve(np.array([0.0, 0.1]), left, right, "left", DT)
+    assert np.linalg.norm(ik.angular_momentum) < 1e-6  # at rest
+    momenta = []
+    for k in range(1, 11):  # swing the right foot forward: the body turns about y
+        swing = sole_pose([0.02 * k, -0.115, 0.05])
+        ik.solve(np.array([0.0, 0.1]), left, swing, "left", DT)
+        momenta.append(ik.angular_momentum.copy())
+    assert ik.angular_momentum.shape == (3,)
+    assert max(abs(m[1]) for m in momenta) > 0.05  # [N m s]
+
+
 def test_ik_rejects_unknown_support(ik):
     with pytest.raises(ParameterError):
         ik.solve(np.zeros(2), np.eye(4), np.eye(4), "none", DT)
@@ -83,6 +98,37 @@ def test_swing_height_profile():
     assert swing_height(0.05, 0.1, 0.8, 0.06) == 0.0
     assert swing_height(0.45, 0.1, 0.8, 0.06) == pytest.approx(0.06)
     assert swing_height(0.8, 0.1, 0.8, 0.06) == pytest.approx(0.0)
+
+
+def test_swing_height_can_touch_down_with_a_vertical_speed():
+    lift_off, landing, apex = 0.1, 0.8, 0.06
+    assert swing_height(landing, lift_off, landing, apex, 0.05) == pytest.approx(0.0)
+    h = 1e-5
+    descent = (swing_height(landing - h, lift_off, landing, apex, 0.05) - 0.0) / h
+    assert descent == pytest.approx(0.05, rel=1e-3)  # lands at 0.05 m/s
+    # 30 ms before landing the sole is still clearly above the ground.
+    early = swing_height(landing - 0.03, lift_off, landing, apex, 0.05)
+    assert early > swing_height(landing - 0.03, lift_off, landing, apex) + 1e-3
+    with pytest.raises(ParameterError):
+        SwingFootTrajectory(TIMING, touchdown_speed=-0.1)
+
+
+def test_smooth_swing_starts_without_acceleration_and_lands_on_target():
+    timing = SwingTiming()
+    smooth = SwingFootTrajectory(timing, smooth_horizontal=True)
+    cubic = SwingFootTrajectory(timing)
+    target = np.array([0.2, -0.1])
+    for trajectory in (smooth, cubic):
+        trajectory.start(np.array([0.0, -0.1]))
+    first = {}
+    for k in range(1, round(timing.nominal_step / DT) + 1):
+        for name, trajectory in (("smooth", smooth), ("cubic", cubic)):
+            trajectory.update(k * DT, target, DT)
+            if k * DT == pytest.approx(timing.double_support + DT):
+                first[name] = np.linalg.norm(trajectory.velocity)
+    assert first["smooth"] < 0.2 * first["cubic"]  # gentle lift-off
+    assert np.allclose(smooth.position[:2], target, atol=1e-4)
+    assert np.allclose(smooth.velocity, 0.0, atol=1e-3)
 
 
 def test_lipm_integration_matches_the_closed_form_and_includes_the_momentum():

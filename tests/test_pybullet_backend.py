@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from app.backend import InitialCondition
-from app.pybullet_backend import PyBulletBackend
+from app.pybullet_backend import PyBulletBackend, _clip_to_hull
+from planner.exceptions import ParameterError
 from planner.types import Foothold, PlannerOutput, StepEvent
 
 LEFT = Foothold("left", np.array([0.0, 0.115]))
@@ -97,6 +100,49 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
     stand(backend, 3.0, push)
     status = backend.fall_status()
     assert status.fell and status.reason
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        {"transfer_lift": -0.001},
+        {"transfer_lift": 0.05},
+        {"transfer_ramp": 0.0},
+        {"momentum_compensation": 1.5},
+        {"momentum_filter": 0.0},
+        {"cop_margin": 0.03},
+    ],
+)
+def test_walking_options_are_validated(options):
+    with pytest.raises(ParameterError):
+        PyBulletBackend("g1", **options)
+
+
+def test_old_foot_is_lifted_after_the_step_and_the_cop_plan_stays_on_the_sole(backend):
+    backend.reset(InitialCondition(LEFT, RIGHT, np.array([0.0, 0.05]), np.zeros(2)))
+    backend.transfer_lift, backend.momentum_compensation = 0.003, 1.0
+    event = StepEvent(0.0, "right", RIGHT.position, False, False)
+    lifts = []
+    for tick in range(8):
+        time = tick * backend.control_period
+        out = command(time, RIGHT.position, stance=RIGHT, swing=LEFT, since_step=time)
+        out = dataclasses.replace(out, step=event if tick == 0 else None)
+        backend.step(out, np.zeros(2))
+        lifts.append(backend.ik.sole_world("left")[2, 3])
+        # A commanded pivot far outside the sole is clipped onto it.
+        far = dataclasses.replace(out, zmp=RIGHT.position + np.array([0.0, -0.3]))
+        zmp, _ = backend._momentum_aware_pivot(far, far.zmp, np.zeros(2))
+        assert RIGHT.position[1] - 0.025 - 1e-9 <= zmp[1] <= RIGHT.position[1] + 0.025
+    assert lifts[0] < lifts[-1] == pytest.approx(0.003, abs=5e-4)
+    assert not backend.fall_status().fell
+
+
+def test_clip_to_hull_keeps_inside_points_and_projects_outside_ones():
+    corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [2.0, 0.5]])
+    inside = np.array([1.2, 0.5])
+    assert np.array_equal(_clip_to_hull(inside, corners), inside)
+    assert np.allclose(_clip_to_hull(np.array([0.5, -1.0]), corners), [0.5, 0.0])
+    assert np.allclose(_clip_to_hull(np.array([-1.0, 2.0]), corners), [0.0, 1.0])
 
 
 def test_same_commands_give_the_same_result():

@@ -1,0 +1,88 @@
+"""The RSG walking the Unitree G1 in PyBullet (slow: full-robot runs).
+
+The walk and paper-fig6 tests state the goal of the full-robot backend. They are
+marked ``xfail(strict=True)`` while the goal is not met, so that they start to
+fail (and the marker must go) as soon as the robot walks. Status, measured with
+the G1 defaults of ``robots/g1.py``: the walk falls after about 5.7 s (8 steps, 6
+of them adjusted by the RSG); see the module notes of ``app/pybullet_backend.py``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from app.robot_setup import build_robot_backend
+from app.runner import ClosedLoop, RunResult
+from app.scenarios import BUILT_IN, Scenario
+
+pytestmark = pytest.mark.slow
+
+LANDING_TOLERANCE = 0.03  # [m] measured sole vs. the planner's step position
+NOT_YET = "G1 walk not achieved yet: falls after ~5.7 s (lateral DCM drift)"
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def run_g1(
+    scenario: Scenario, controller: str = "rsg", duration: float | None = None
+) -> tuple[RunResult, list[float]]:
+    """Run ``scenario`` on G1; returns the result and each step's landing error [m].
+
+    The landing error is measured at the end of the step's double support, when
+    the new stance foot is down: the distance between the measured sole and the
+    planner's step position.
+    """
+    backend, config, initial = build_robot_backend("g1", controller)
+    if duration is not None:
+        scenario = dataclasses.replace(scenario, duration=duration)
+    scaled, _ = scenario.scaled_to(backend.mass)
+    loop = ClosedLoop(backend, config, scaled, initial)
+    errors: list[float] = []
+    pending = None
+    try:
+        for _ in range(round(scaled.duration / loop.period)):
+            out = loop.tick()
+            if out.step is not None:
+                pending = out.stance
+            if pending is not None and not out.double_support and out.step is None:
+                sole = backend.sole_positions()[pending.foot][:2]
+                errors.append(float(np.linalg.norm(sole - pending.position)))
+                pending = None
+            if backend.fall_status().fell:
+                break
+        return loop.result(), errors
+    finally:
+        backend.close()
+
+
+def test_two_identical_runs_give_identical_results():
+    first, first_errors = run_g1(BUILT_IN["walk"], duration=1.5)
+    second, second_errors = run_g1(BUILT_IN["walk"], duration=1.5)
+    assert np.array_equal(first.timeseries, second.timeseries)
+    assert first_errors == second_errors
+    assert [s.event for s in first.steps] == [s.event for s in second.steps]
+
+
+@pytest.mark.xfail(strict=True, reason=NOT_YET)
+def test_g1_walks_20_s_with_the_rsg_and_lands_where_planned():
+    result, errors = run_g1(BUILT_IN["walk"], duration=20.0)
+    assert not result.fall.fell, result.fall.reason
+    assert result.sim_time == pytest.approx(20.0)
+    assert len(errors) >= 20
+    assert max(errors) < LANDING_TOLERANCE
+    assert result.recovered
+
+
+@pytest.mark.xfail(strict=True, reason=NOT_YET)
+def test_g1_recovers_paper_fig6_with_an_adjusted_step():
+    scenario = BUILT_IN["paper-fig6"]
+    result, _ = run_g1(scenario)
+    assert result.recovered, result.fall.reason
+    first_push = scenario.pushes[0].time
+    assert any(s.event["adjusted"] and s.event["t"] > first_push for s in result.steps)
