@@ -161,21 +161,29 @@ def _is_feasible(problem: StepQpProblem) -> bool:
 
 
 def solve_with_qpsolvers(problem: StepQpProblem, solver: str = "proxqp") -> np.ndarray | None:
-    """Solve min (d-u)^T P (d-u) s.t. G u <= h, lb <= u <= ub with qpsolvers.
+    """Solve min (d-u)^T P (d-u) s.t. (27b)-(27d) with qpsolvers.
+
+    (27b) and (27c) both bound sigma+ u_d,y from below, so with (27d) the feasible set
+    is the box :meth:`StepQpProblem.box`, which is what the solver receives (as lb,
+    ub). Given as two parallel inequality rows, the active constraints are not
+    linearly independent when both are near-active, and proxqp then stopped up to
+    1.3 cm from the optimum on 7 of 1000 sampled problems; as bounds it matches the
+    exact minimiser to 1e-9 m on all of them (tests/test_step_qp.py).
 
     Returns:
-        u_d, or None if the solver reports no solution.
+        u_d, or None if the solver reports no solution or the box is empty.
     """
+    lower, upper = problem.box()
+    if np.any(lower > upper):
+        return None
     p = 2.0 * problem.lyapunov_matrix
     q = -2.0 * problem.lyapunov_matrix @ problem.target
     try:
         x = qpsolvers.solve_qp(
             p,
             q,
-            G=problem.inequality_matrix,
-            h=problem.inequality_vector,
-            lb=problem.lower,
-            ub=problem.upper,
+            lb=lower,
+            ub=upper,
             solver=solver,
             eps_abs=1e-9,
             eps_rel=0.0,

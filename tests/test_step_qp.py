@@ -113,3 +113,22 @@ def test_infeasible_problem_falls_back_without_27c():
         assert not solution.feasible
         assert problem.max_violation(solution.step, with_com=False) < 1e-6
         assert solution.step[1] == pytest.approx(CONSTRAINTS.step_min[1], abs=1e-6)
+
+
+def test_proxqp_matches_the_exact_minimiser_on_many_problems():
+    """proxqp (through qpsolvers) and the exact box method agree on 1000 sampled QPs,
+    including those where (27b) and (27c) are both nearly active."""
+    rng = np.random.default_rng(0)
+    compared = 0
+    for index in range(1000):
+        sigma = 1 if index % 2 else -1
+        xi1_reference = np.array([rng.uniform(-0.1, 0.1), -sigma * rng.uniform(0.0, 0.1)])
+        error = rng.normal(0.0, 0.15, 2)
+        xi1 = xi1_reference + rng.normal(0.0, 0.05, 2)
+        problem = build_step_qp(P_U, error, xi1, xi1_reference, sigma, CONSTRAINTS, PARAMS)
+        proxqp = solve_step_qp(problem, "proxqp")
+        exact = solve_step_qp(problem, "exact")
+        assert proxqp.feasible == exact.feasible
+        np.testing.assert_allclose(proxqp.step, exact.step, atol=1e-6, err_msg=f"{index=}")
+        compared += 1
+    assert compared == 1000
