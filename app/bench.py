@@ -14,8 +14,13 @@ Measured in one process, one after the other:
   walk (the backend's files are not touched);
 - ``loop``: one control tick of the full-robot closed loop, and its real-time factor.
 
-Each figure is the median and 95th percentile [s] over the calls. The placo-wpg
-baseline's planner column is filled when :mod:`app.placo_wpg` provides one.
+- ``placo_wpg``: the same walk with the placo-wpg baseline (:mod:`app.placo_wpg`)
+  as the planner: its planner tick (``rsg_tick``/``rsg_step_tick`` keys: ticks
+  without/with a step; on the robot, as the baseline exists only there), IK,
+  physics and the whole tick, in the same process right after the RSG's walk.
+  ``robot_planner_tick`` is the planner's tick on the robot for both.
+
+Each figure is the median and 95th percentile [s] over the calls.
 """
 
 from __future__ import annotations
@@ -121,18 +126,39 @@ def bench_step_qp(samples: int = 500, seed: int = 0) -> dict:
     }
 
 
-def bench_robot(robot: str, duration: float) -> dict:
-    """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then)."""
-    from .setup import build_backend
+def bench_robot(robot: str, duration: float, controller: str = "rsg") -> dict:
+    """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then).
 
-    backend, config, initial = build_backend("pybullet", robot, "rsg")
+    With ``controller="placo-wpg"`` the planner is the placo baseline, and its
+    ticks are timed too (``rsg_tick``/``rsg_step_tick`` keys: without/with a step).
+    """
+    planner = None
+    if controller == "placo-wpg":
+        from .placo_wpg import build_placo_wpg_backend
+
+        backend, config, initial, planner = build_placo_wpg_backend(robot)
+    else:
+        from .setup import build_backend
+
+        backend, config, initial = build_backend("pybullet", robot, controller)
     ik_times: list[float] = []
     physics_times: list[float] = []
     tick_times: list[float] = []
+    flow: list[float] = []
+    jump: list[float] = []
     try:
         backend.ik.solve = timed(backend.ik.solve, ik_times)  # type: ignore[attr-defined]
         backend.sim.step = timed(backend.sim.step, physics_times)  # type: ignore[attr-defined]
-        loop = ClosedLoop(backend, config, Scenario("walk", duration), initial)
+        loop = ClosedLoop(backend, config, Scenario("walk", duration), initial, planner=planner)
+        update = loop.generator.update
+
+        def timed_update(measured: Any, period: float) -> Any:
+            start = time.perf_counter()
+            out = update(measured, period)
+            (jump if out.step is not None else flow).append(time.perf_counter() - start)
+            return out
+
+        loop.generator.update = timed_update  # type: ignore[method-assign]
         ik_times.clear()  # the reset's solves are not ticks
         wall = time.perf_counter()
         for _ in range(int(round(duration / loop.period))):
@@ -148,7 +174,10 @@ def bench_robot(robot: str, duration: float) -> dict:
         timers = {k: v / ticks for k, v in getattr(backend, "timers", {}).items()}
     finally:
         backend.close()
+    planner_ticks = {"rsg_tick": stats(flow), "rsg_step_tick": stats(jump)}
     return {
+        **({} if planner is None else planner_ticks),
+        "robot_planner_tick": stats(flow + jump),
         "ik": stats(ik_times),
         "physics": stats(physics_times),
         "loop_tick": stats(tick_times),
@@ -161,19 +190,15 @@ def bench_robot(robot: str, duration: float) -> dict:
     }
 
 
-def bench_placo_wpg(robot: str, duration: float) -> dict | None:
-    """The same figures for the placo-wpg baseline, if it exists."""
-    try:
-        from .placo_wpg import bench_figures  # type: ignore[attr-defined]
-    except ImportError:
-        return None
-    result: dict = bench_figures(robot, duration)
-    return result
+def bench_placo_wpg(robot: str, duration: float) -> dict:
+    """The same figures for the placo-wpg baseline (its planner ticks on the robot)."""
+    return bench_robot(robot, duration, "placo-wpg")
 
 
 ROWS = (
-    ("rsg_tick", "planner tick (continuous part)"),
-    ("rsg_step_tick", "planner tick with a step"),
+    ("rsg_tick", "planner tick without a step (rsg: LIPM; placo-wpg: robot)"),
+    ("rsg_step_tick", "planner tick with a step (rsg: LIPM; placo-wpg: robot)"),
+    ("robot_planner_tick", "planner tick on the robot (all ticks)"),
     ("qp_proxqp", "step QP, proxqp"),
     ("qp_exact", "step QP, exact box"),
     ("ik", "IK solve"),

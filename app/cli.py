@@ -27,6 +27,7 @@ examples:
   rsg run --model lipm --scenario paper-fig6 --out results/fig6
   rsg run --model lipm --controller no-step --scenario walk --push 3:0,25 --out results/side
   rsg run --model lipm --scenario my_pushes.toml --out results/mine
+  rsg run --model pybullet --controller placo-wpg --scenario walk --duration 4 --out results/wpg
 
 outputs in --out:
   summary.json     verdict (recovered, fell), steps, pushes, Lyapunov levels, counts
@@ -87,10 +88,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
     run.add_argument(
         "--controller",
-        choices=CONTROLLERS,
+        choices=(*CONTROLLERS, "placo-wpg"),
         default="rsg",
         help="rsg: step time and location adjusted; fixed-timing: location only; "
-        "no-step: nominal steps (default: rsg)",
+        "no-step: nominal steps; placo-wpg: placo's WalkPatternGenerator with "
+        "update_supports (--model pybullet only) (default: rsg)",
     )
     run.add_argument(
         "--scenario",

@@ -6,6 +6,9 @@ import argparse
 import sys
 from pathlib import Path
 
+from planner.exceptions import ParameterError
+from planner.parameters import CONTROLLERS
+
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
@@ -58,7 +61,20 @@ def run_command(args: argparse.Namespace) -> int:
             scenario.description,
             scenario.reference_mass,
         )
-    backend, config, initial = build_backend(args.model, args.robot, args.controller)
+    planner = None
+    if args.controller == "placo-wpg":
+        if args.model != "pybullet":
+            raise ParameterError(
+                "--controller",
+                "placo-wpg",
+                "--model pybullet with placo-wpg (it drives the full robot's IK), or one of "
+                f"{', '.join(CONTROLLERS)} on --model {args.model}",
+            )
+        from .placo_wpg import build_placo_wpg_backend
+
+        backend, config, initial, planner = build_placo_wpg_backend(args.robot)
+    else:
+        backend, config, initial = build_backend(args.model, args.robot, args.controller)
     try:
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:
@@ -72,6 +88,7 @@ def run_command(args: argparse.Namespace) -> int:
             scaled,
             initial,
             progress=ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet),
+            planner=planner,
         )
         result.impulse_scale = factor
     finally:

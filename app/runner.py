@@ -14,6 +14,7 @@ from __future__ import annotations
 import time as wallclock
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -36,6 +37,24 @@ TIMESERIES_COLUMNS = (
     "dcm_error_x", "dcm_error_y", "lyapunov", "time_since_step",
     "push_fx", "push_fy",
 )  # fmt: skip
+
+
+class StepPlanner(Protocol):
+    """What the loop needs of a planner: the RSG's interface.
+
+    ``design`` has ``threshold`` (gamma_v), ``matrix`` and ``gain`` (written to
+    the results); :class:`planner.step_generator.ReactiveStepGenerator` is one,
+    the placo-wpg baseline (:mod:`app.placo_wpg`) another.
+    """
+
+    design: Any
+
+    def reset(self, stance: Foothold, previous: Foothold) -> None: ...
+
+    def update(self, measured: MeasuredState, period: float) -> PlannerOutput: ...
+
+
+PlannerFactory = Callable[[PlannerConfig], StepPlanner]
 
 CONSTRAINTS = ("zmp_window", "angular_momentum", "step_bounds", "crossing", "com_between_feet")
 
@@ -170,6 +189,8 @@ class ClosedLoop:
         initial: Start state; default :func:`walking_start`.
         qp_solver: ``"proxqp"`` or ``"exact"`` for the QP (27).
         capacity: Ticks to pre-allocate for the time series (grows when needed).
+        planner: Builds the planner from ``config``; default the RSG
+            (:class:`ReactiveStepGenerator` with ``qp_solver``).
     """
 
     def __init__(
@@ -180,12 +201,17 @@ class ClosedLoop:
         initial: InitialCondition | None = None,
         qp_solver: str = "proxqp",
         capacity: int | None = None,
+        planner: PlannerFactory | None = None,
     ) -> None:
         self.backend = backend
         self.config = config
         self.scenario = scenario
         self.initial = initial or walking_start(config)
-        self.generator = ReactiveStepGenerator(config, qp_solver=qp_solver)
+        self.generator: StepPlanner = (
+            ReactiveStepGenerator(config, qp_solver=qp_solver)
+            if planner is None
+            else planner(config)
+        )
         self.period = backend.control_period
         self._capacity = capacity or int(round(scenario.duration / self.period)) + 1
         self.reset()
@@ -271,6 +297,7 @@ def run_closed_loop(
     initial: InitialCondition | None = None,
     progress: Callable[[float], None] | None = None,
     qp_solver: str = "proxqp",
+    planner: PlannerFactory | None = None,
 ) -> RunResult:
     """Run ``scenario`` with the planner of ``config`` on ``backend``.
 
@@ -281,11 +308,12 @@ def run_closed_loop(
         initial: Start state; default :func:`walking_start`.
         progress: Called with the fraction done, about 100 times a run.
         qp_solver: ``"proxqp"`` or ``"exact"`` for the QP (27).
+        planner: Builds another planner than the RSG (see :class:`ClosedLoop`).
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.
     """
-    loop = ClosedLoop(backend, config, scenario, initial, qp_solver)
+    loop = ClosedLoop(backend, config, scenario, initial, qp_solver, planner=planner)
     ticks = int(round(scenario.duration / loop.period))
     report_every = max(1, ticks // 100)
     for tick in range(ticks):

@@ -95,11 +95,6 @@ class SweepSpec:
             raise ParameterError(
                 "controllers", ",".join(self.controllers), f"distinct of {SWEEP_CONTROLLERS}"
             )
-        if PLACO_WPG in self.controllers:
-            from .placo_wpg import AVAILABLE, REASON
-
-            if not AVAILABLE:
-                raise ParameterError("controllers", PLACO_WPG, REASON)
         if PLACO_WPG in self.controllers and self.model != "pybullet":
             raise ParameterError(
                 "controllers",
@@ -191,10 +186,20 @@ def push_timing(config: PlannerConfig, cycle: int, phase: float) -> tuple[float,
 
 
 def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
+    """Backend, configuration and initial condition of ``controller`` (see :func:`_build_job`)."""
+    return _build_job(spec, controller)[:3]
+
+
+def _build_job(spec: SweepSpec, controller: str):  # noqa: ANN202
+    """Backend, configuration, initial condition and planner factory (None: the RSG's)."""
     if controller == PLACO_WPG:
         from .placo_wpg import build_placo_wpg_backend
 
         return build_placo_wpg_backend(spec.robot)
+    return (*_build_rsg(spec, controller), None)
+
+
+def _build_rsg(spec: SweepSpec, controller: str):  # noqa: ANN202
     from .setup import build_backend
 
     backend, config, initial = build_backend(spec.model, spec.robot, controller)
@@ -254,8 +259,9 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
     from .runner import run_closed_loop
 
     started = time.perf_counter()
-    backend, config, initial = _build(spec, job.controller)
+    backend, config, initial, planner = _build_job(spec, job.controller)
     runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
+    options = {} if planner is None else {"planner": planner}
     early = spec.model == "lipm" and spec.criterion == "recovered"
     try:
         t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
@@ -272,7 +278,7 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
             scenario = Scenario("sweep", t_push + spec.settle, (push,))
             if trial is not None:
                 return trial.recovered(push)
-            result = runner(backend, config, scenario, initial, qp_solver=spec.qp_solver)
+            result = runner(backend, config, scenario, initial, qp_solver=spec.qp_solver, **options)
             if spec.criterion == "no-fall":
                 return not result.fall.fell
             return bool(result.recovered)

@@ -83,9 +83,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     """Run ``rsg sweep``; returns 0."""
     controllers = args.controllers
     if controllers is None:
-        from .placo_wpg import AVAILABLE
-
-        with_wpg = args.model == "pybullet" and AVAILABLE
+        with_wpg = args.model == "pybullet"
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
     elif PLACO_WPG in controllers and args.model == "lipm":
         raise ParameterError(
