@@ -22,24 +22,25 @@ folder skips the jobs found there, so an interrupted sweep resumes where it stop
 
 from __future__ import annotations
 
-import copy
 import json
 import math
 import sys
 import time
-from collections.abc import Callable, Iterable
+from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
 from planner.exceptions import ParameterError, RsgError
-from planner.parameters import CONTROLLERS, PlannerConfig
+from planner.parameters import CONTROLLERS
 from planner.types import Push
 
+from .bisection import bisect_threshold
 from .capturability import impulse_bound
 from .scenarios import Scenario
+from .sweep_trial import SettledTrial, push_timing
 
 PLACO_WPG = "placo-wpg"
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
@@ -141,50 +142,6 @@ class Job:
         return f"{self.controller}|{math.degrees(self.angle):.4f}|{self.phase:.4f}"
 
 
-@dataclass
-class Bisection:
-    """Result of :func:`bisect_threshold`: largest passing and smallest failing value."""
-
-    passed: float
-    failed: float | None
-    evaluations: list[tuple[float, bool]] = field(default_factory=list)
-
-
-def bisect_threshold(
-    predicate: Callable[[float], bool], upper: float, tolerance: float
-) -> Bisection:
-    """Largest x in [0, upper] with ``predicate(x)`` true, for a predicate monotone in x.
-
-    Evaluates ``upper`` first (if it passes, the answer is ``upper`` and ``failed`` is
-    None), then 0 (if it fails, the answer is 0), then bisects until the bracket is
-    narrower than ``tolerance``.
-    """
-    result = Bisection(0.0, upper)
-    for probe in (upper, 0.0):
-        ok = predicate(probe)
-        result.evaluations.append((probe, ok))
-        if ok and probe == upper:
-            return Bisection(upper, None, result.evaluations)
-        if not ok and probe == 0.0:
-            return Bisection(0.0, 0.0, result.evaluations)
-    low, high = 0.0, upper
-    while high - low > tolerance:
-        middle = 0.5 * (low + high)
-        ok = predicate(middle)
-        result.evaluations.append((middle, ok))
-        low, high = (middle, high) if ok else (low, middle)
-    return Bisection(low, high, result.evaluations)
-
-
-def push_timing(config: PlannerConfig, cycle: int, phase: float) -> tuple[float, int, float]:
-    """(push start [s], stance sigma, s~ [s]) for ``phase`` of walking cycle ``cycle``."""
-    gait = config.gait
-    step_time = gait.single_support_duration + (cycle - 1) * gait.step_duration
-    sigma = 1 if cycle % 2 == 0 else -1
-    since_step = phase * gait.step_duration
-    return step_time + since_step, sigma, since_step
-
-
 def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
     """Backend, configuration and initial condition of ``controller`` (see :func:`_build_job`)."""
     return _build_job(spec, controller)[:3]
@@ -208,50 +165,6 @@ def _build_rsg(spec: SweepSpec, controller: str):  # noqa: ANN202
 
         backend = LipmBackend(config.model, fall_dcm_error=spec.fall_dcm_error)
     return backend, config, initial
-
-
-class SettledTrial:
-    """Recovery verdicts of one push time, each run from a snapshot taken before the push.
-
-    The walk up to the push is simulated once; each trial deep-copies that loop, adds
-    its push and runs on. The verdict is :attr:`RunResult.recovered` of the full run,
-    returned early: at a fall (False), or once the push is over, two nominal steps
-    have followed it and V_u < gamma_v at the second (True: from there the
-    undisturbed LIPM walks on nominally; a test checks the verdicts are equal).
-
-    Args:
-        backend, config, initial: As for :func:`app.runner.run_closed_loop`.
-        push_time: Start of the pushes to try [s].
-        end_time: Simulated time at which an unsettled run is judged [s].
-        qp_solver: ``exact`` or ``proxqp``.
-    """
-
-    def __init__(self, backend, config, initial, push_time: float, end_time: float,
-                 qp_solver: str = "exact") -> None:  # fmt: skip
-        from .runner import ClosedLoop
-
-        self.end_time = end_time
-        loop = ClosedLoop(backend, config, Scenario("sweep", end_time), initial, qp_solver)
-        for _ in range(int(math.floor(push_time / loop.period + 1e-9))):
-            loop.tick()
-        self.loop = copy.deepcopy(loop)  # independent of later uses of ``backend``
-
-    def recovered(self, push: Push) -> bool:
-        """Verdict for ``push`` (its time >= the snapshot's)."""
-        loop = copy.deepcopy(self.loop)
-        loop.add_push(push)
-        backend = loop.backend
-        push_end = push.time + push.duration
-        nominal_in_a_row = 0
-        while loop.ticks < int(round(self.end_time / loop.period)):
-            out = loop.tick()
-            if backend.fall_status().fell:
-                return False
-            if out.step is not None and out.time > push_end:
-                nominal_in_a_row = 0 if out.step.adjusted else nominal_in_a_row + 1
-                if nominal_in_a_row >= 2 and out.lyapunov < loop.generator.design.threshold:
-                    return True
-        return bool(loop.result().recovered)
 
 
 def run_job(spec: SweepSpec, job: Job) -> dict:
