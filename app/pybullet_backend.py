@@ -58,10 +58,28 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   address it; they help the ``no-step`` walk (3.1 s -> 4.7 s), as does
   ``smooth_swing`` (minimum-jerk swing, smaller Ldot at lift-off: 3.1 s -> 5.2 s),
   but not the RSG (4.0-4.6 s against 5.7 s), so they are off by default.
-* Remaining limitation: the RSG's threshold gamma_v corresponds to a DCM error of
-  ~1.1 cm on G1 (window 2 cm / gain 1.85). Errors of 1-2 cm (touchdown, CoP
-  clipped at the sole's edge, swing re-timing) keep triggering timing and location
-  adjustments; the walk then drifts laterally and falls after ~5-6 s.
+* Landing. Three measured mechanisms made the walk's DCM error jump at landings,
+  each above the RSG's threshold (gamma_v is a DCM error of ~1.1 cm on G1: window
+  2 cm / gain 1.85), so each caused adjusted steps that stirred new errors:
+  (1) the planner's double-support pivot overshoots the new sole by |step| theta /
+  T_DSP (theta = 0.05 s: up to 8 cm), which the sole cannot realise: G1 uses
+  theta = 0.01 s (``RobotDescription.filter_time_constant``); (2) the feet landed
+  on the planner's announced ``next_step`` while its jump puts o_H (4.5, 7) mm
+  further, and the offsets added up from step to step (``landing_correction``,
+  ``app/pybullet_landing.py``); (3) a sole commanded down to the ground touched
+  it 30-40 ms before the step and took the whole weight with an impact (up to
+  940 N): ``landing_clearance`` keeps it 2 mm up until the step. With the three,
+  the 20 s walk has no adjusted step (max V_u 0.69 gamma_v) for rsg,
+  fixed-timing and no-step.
+* Remaining limitation: an adjusted step is taken at once wherever the swing
+  foot is. In paper-fig6 the RSG steps 0.05 s after the first push (as it does on
+  the LIPM with G1's parameters, which recovers) to a foothold 7.8 cm from the
+  swing sole, which is still 1.8 cm up: the IK's hard stance task drags the foot
+  there within one tick and the robot falls ~2 s later. A "late landing" (old
+  foot kept as support while the foot travels over 0.08-0.15 s, across first and
+  then down, CoM plan clipped to the old sole) was tried and did not help (falls
+  at 4.7-4.9 s instead of 5.9 s): moving the leg 7 cm that fast kicks the CoM
+  (0.1 m/s sideways) and the DCM error reaches 5 cm.
 """
 
 from __future__ import annotations
@@ -76,6 +94,7 @@ from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 from app.backend import FallStatus, InitialCondition
+from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.com_plan import GRAVITY, ROTATION_90, lipm_integrate
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
@@ -123,6 +142,8 @@ class PyBulletBackend:
         touchdown_speed: float = 0.0,
         landing_delay: float = 0.0,
         smooth_swing: bool = False,
+        landing_correction: float | tuple[float, float] = 0.0,
+        landing_clearance: float = 0.0,
     ) -> None:
         """Load the robot.
 
@@ -172,6 +193,13 @@ class PyBulletBackend:
                 predicted step time [s] (its jump comes one control tick after it).
             cop_margin: Distance [m] kept between the CoP the CoM plan asks for and
                 the edges of the stance sole when ``momentum_compensation`` > 0.
+            landing_correction: Gain [-] (or per axis: forward, outward) of
+                :class:`app.pybullet_landing.LandingCorrection`: the swing foot
+                aims where the planner's jump will put o_H.
+            landing_clearance: The swing sole never goes below this height [m];
+                at the step the new stance sole target is lowered from it to the
+                ground over ``transfer_ramp`` (a foot commanded onto the ground
+                touches it early, see the module notes).
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -221,6 +249,10 @@ class PyBulletBackend:
         self.cop_margin = cop_margin
         self._ik_momentum: NDArray[np.float64] | None = None
         self._ik_momentum_rate = np.zeros(2)
+        self.landing = LandingCorrection(landing_correction)
+        if not 0.0 <= landing_clearance <= 0.01:
+            raise ParameterError("landing_clearance", landing_clearance, "in [0, 0.01] m")
+        self.landing_clearance = landing_clearance
         self._com_reference = np.zeros(2)
         self._com_velocity_reference = np.zeros(2)
         self.timing = timing or SwingTiming()
@@ -292,6 +324,7 @@ class PyBulletBackend:
         self._com_velocity_reference = com_velocity.copy()
         self._ik_momentum = None
         self._ik_momentum_rate = np.zeros(2)
+        self.landing.reset()
         return self._measured
 
     def _ik_reset(
@@ -328,8 +361,11 @@ class PyBulletBackend:
             + self.landing_delay
             - self.touchdown_lead
         )
-        swing_position = self.swing.update(time_since_step, command.next_step.position, dt, landing)
+        self.landing.observe(command)
+        target = self.landing.target(command)
+        swing_position = self.swing.update(time_since_step, target, dt, landing)
         swing_position[2] = max(swing_position[2] - self._press_depth(swing_position), -0.01)
+        swing_position[2] = max(swing_position[2], self.landing_clearance)
         if self.transfer_lift > 0.0 and time_since_step < self.timing.double_support + 0.1:
             # The old stance foot leaves the ground at the step: the new one takes
             # the weight at once (kept until the swing profile rises above it).
@@ -338,7 +374,7 @@ class PyBulletBackend:
             lift = self.transfer_lift * min(time_since_step / self.transfer_ramp, 1.0)
             swing_position[2] = max(swing_position[2], lift)
         soles = {
-            stance: _ground_pose(command.stance.position),
+            stance: sole_pose(np.array([*command.stance.position, self._settle(time_since_step)])),
             swing_foot: sole_pose(swing_position),
         }
 
@@ -372,6 +408,10 @@ class PyBulletBackend:
         self.timers["estimation"] += measured_at - stepped
         self.ticks += 1
         return self._measured
+
+    def _settle(self, time_since_step: float) -> float:
+        """Height [m] of the new stance sole target: ``landing_clearance`` ramped to 0."""
+        return self.landing_clearance * max(0.0, 1.0 - time_since_step / self.transfer_ramp)
 
     def _press_depth(self, swing_position: NDArray[np.float64]) -> float:
         """How far below the ground the landed swing sole is commanded [m]."""

@@ -50,6 +50,7 @@ def planner_config_for(
             lqr_zmp_scale=half_width,
             lqr_angular_momentum_scale=description.angular_momentum_rate_max,
             swing_preparation_time=description.swing_preparation_time,
+            filter_time_constant=description.filter_time_constant,
         ),
         controller=controller,
     )

@@ -99,6 +99,8 @@ class RobotDescription:
         lqr_dcm_error_scale: DCM error scale e_max of the LQR (Bryson) [m].
         swing_preparation_time: T_SP, time the swing foot needs after the double
             support before it can land [s] (bounds how early the planner may step).
+        filter_time_constant: theta, the planner's low-pass filter on its
+            continuous input and double-support compensation [s].
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         backend_options: Keyword arguments of the PyBullet backend tuned for
@@ -132,6 +134,7 @@ class RobotDescription:
     angular_momentum_rate_max: float = 3.0
     lqr_dcm_error_scale: float = 0.03
     swing_preparation_time: float = 0.2
+    filter_time_constant: float = 0.05
     sole_box_collision: bool = False
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 

@@ -17,6 +17,26 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   error per step).
 * ``momentum_compensation`` 1: the CoM plan accounts for the angular momentum of
   the IK motion itself, keeping the CoP inside the 5 cm wide sole.
+* ``filter_time_constant`` theta = 0.01 s instead of the planner's 0.05 s: theta
+  also filters the planner's double-support compensation, so its effective pivot
+  (ZMP - S hdot / (m g)) lags the moving window and overshoots the new sole by
+  |step| theta / T_DSP (8 cm forward-outward at 0.05 s, ~2 cm at 0.01 s), while the
+  robot, whose weight moves onto the new foot at the step (``transfer_lift``),
+  keeps its CoP on that sole. With 0.01 s: no-step 3.1 s -> 7.3 s, fixed-timing
+  3.6 s -> 6.8 s, rsg 5.7 s -> 6.9 s (before the two landing fixes below; with
+  them, 0.05 s falls at 4.1 s).
+* ``landing_correction`` 1 (``app/pybullet_landing.py``): the planner's foothold at
+  its jump is (4.5, 7) mm further than its last announcement; landing on the
+  announcement made the feet lag the footholds by 2.3 mm more at every step
+  (2.8 cm after 12 steps, e_x -> -1.2 cm). Without it the RSG walk falls at 7.0 s.
+* ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
+  30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
+  toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's
+  threshold (~1.1 cm): an adjusted step. The sole now waits 2 mm above the ground
+  and the new stance sole is lowered to it over ``transfer_ramp`` after the step.
+  Without it the RSG walk falls at 5.2 s; with it (and the two choices above) the
+  20 s walk has no adjusted step and V_u stays below 0.7 gamma_v, for rsg,
+  fixed-timing and no-step alike (1, 2 and 3 mm all walk the 20 s).
 """
 
 from __future__ import annotations
@@ -91,6 +111,7 @@ G1 = RobotDescription(
     swing_height=0.06,
     sole_box_collision=True,
     swing_preparation_time=0.5,
+    filter_time_constant=0.01,
     backend_options={
         "com_reference_blend": 0.05,
         "com_tracking_gains": (1.0, 0.0),
@@ -98,5 +119,7 @@ G1 = RobotDescription(
         "momentum_compensation": 1.0,
         "momentum_filter": 0.05,
         "cop_margin": 0.0,
+        "landing_correction": 1.0,
+        "landing_clearance": 0.002,
     },
 )

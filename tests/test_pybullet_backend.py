@@ -111,6 +111,9 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
         {"momentum_compensation": 1.5},
         {"momentum_filter": 0.0},
         {"cop_margin": 0.03},
+        {"landing_clearance": -0.001},
+        {"landing_clearance": 0.02},
+        {"landing_correction": 2.0},
     ],
 )
 def test_walking_options_are_validated(options):
@@ -182,4 +185,20 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     assert np.linalg.norm(soles["right"][:2] - landed.position) < 0.01
     assert abs(soles["right"][2]) < 0.005
     assert "right" in backend.feet_in_contact()
+    assert not backend.fall_status().fell
+
+
+def test_landing_clearance_keeps_the_swing_sole_up_until_the_step(backend):
+    backend.landing_clearance = 0.002
+    over_left = LEFT.position.copy()
+    backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+    heights = []
+    for tick in range(round(0.8 / backend.control_period)):
+        time = tick * backend.control_period
+        backend.step(command(time, over_left, since_step=time), np.zeros(2))
+        heights.append(backend.ik.sole_world("right")[2, 3])
+    assert min(heights[20:]) == pytest.approx(0.002, abs=5e-4)
+    # After the step the new stance sole is lowered from the clearance to the ground.
+    assert backend._settle(0.0) == pytest.approx(0.002)
+    assert backend._settle(backend.transfer_ramp) == 0.0
     assert not backend.fall_status().fell
