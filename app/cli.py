@@ -20,10 +20,11 @@ from planner.parameters import CONTROLLERS
 from .scenarios import BUILT_IN, parse_push
 
 MODELS = ("lipm", "pybullet")
-DEFAULT_MODEL = "lipm"
+DEFAULT_MODEL = "pybullet"
 
 RUN_EPILOG = """\
 examples:
+  rsg run --scenario walk --duration 20 --out results/g1-walk       # G1 in PyBullet
   rsg run --model lipm --scenario paper-fig6 --out results/fig6
   rsg run --model lipm --controller no-step --scenario walk --push 3:0,25 --out results/side
   rsg run --model lipm --scenario my_pushes.toml --out results/mine

@@ -84,7 +84,7 @@ def plot_top_view(result: RunResult, path: Path) -> None:
     ax.set_aspect("equal", adjustable="box")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), fontsize=8, ncols=4)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.28), fontsize=8, ncols=4)
     ax.set_title(_title(result, "(a) top view"))
     fig.tight_layout()
     fig.savefig(path, dpi=120)

@@ -154,14 +154,19 @@ def demo_factory() -> Iterator:
         assert demo.stop() == 0, demo.output()
 
 
-def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory):
-    demo = demo_factory("lipm")
+# Robot mass [kg] per model: the page's presets are the paper's impulses x mass / 60 kg.
+MODEL_MASS = {"pybullet": 33.341, "lipm": 60.0}
+
+
+@pytest.mark.parametrize("model", ["pybullet", "lipm"])
+def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory, model):
+    demo = demo_factory(model)
     with tempfile.TemporaryDirectory() as profile:
         context, page = open_page(playwright_api, demo.url, profile)
         try:
             wait_for_status(page, r"t = \d+\.\d+ s")
             wait_for_status(page, "running")
-            page.wait_for_timeout(3000)  # let the robot (CoM ball on its stick) render
+            page.wait_for_timeout(15_000 if model == "pybullet" else 3000)  # let it render
             # Whether a push needs an adjusted step depends on the gait phase it hits
             # (a few phases keep V_u low enough): push again, at most 4 times.
             step = None
@@ -171,7 +176,8 @@ def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory):
                 index, push = demo.wait_for_line(PUSH_LINE, timeout=60, start=before)
                 assert "source=page" in demo.lines[index]
                 impulse = np.array([float(push.group(2)), float(push.group(3))])
-                np.testing.assert_allclose(impulse, [8.0, -6.0], atol=0.06)  # preset, 60 kg
+                expected = np.array([8.0, -6.0]) * MODEL_MASS[model] / 60.0  # paper preset
+                np.testing.assert_allclose(impulse, expected, atol=0.06)
                 push_time = float(push.group(1))
                 try:
                     _, found = demo.wait_for_line(ADJUSTED_LINE, timeout=15, start=index)
@@ -188,7 +194,8 @@ def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory):
             dismiss_notifications(page)
             page.wait_for_timeout(4000)  # a few frames with the adjusted (red) step
             pixels = canvas_pixels(page)
-            page.screenshot(path=str(SCREENSHOT))
+            if model == "pybullet":  # the README shows the robot
+                page.screenshot(path=str(SCREENSHOT))
             assert pixels.mean(axis=2).var() > 100.0, "the 3-D view looks blank"
 
             # A click on the ground aims the push from the robot towards the point.
