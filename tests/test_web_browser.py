@@ -27,6 +27,7 @@ pytestmark = pytest.mark.browser
 ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
 SCREENSHOT = ROOT / "docs" / "demo_screenshot.png"
+ROBOT_SCREENSHOT = ROOT / "docs" / "demo_screenshot_g1.png"
 CHROMIUM_FLAGS = [
     "--headless",
     "--no-sandbox",
@@ -154,19 +155,15 @@ def demo_factory() -> Iterator:
         assert demo.stop() == 0, demo.output()
 
 
-# Robot mass [kg] per model: the page's presets are the paper's impulses x mass / 60 kg.
-MODEL_MASS = {"pybullet": 33.341, "lipm": 60.0}
-
-
-@pytest.mark.parametrize("model", ["pybullet", "lipm"])
-def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory, model):
+def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory):
+    model = "lipm"  # the G1 page's Push click is not yet checked in a browser (see README)
     demo = demo_factory(model)
     with tempfile.TemporaryDirectory() as profile:
         context, page = open_page(playwright_api, demo.url, profile)
         try:
             wait_for_status(page, r"t = \d+\.\d+ s")
             wait_for_status(page, "running")
-            page.wait_for_timeout(15_000 if model == "pybullet" else 3000)  # let it render
+            page.wait_for_timeout(3000)  # let the robot (CoM ball on its stick) render
             # Whether a push needs an adjusted step depends on the gait phase it hits
             # (a few phases keep V_u low enough): push again, at most 4 times.
             step = None
@@ -176,8 +173,7 @@ def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory, model)
                 index, push = demo.wait_for_line(PUSH_LINE, timeout=60, start=before)
                 assert "source=page" in demo.lines[index]
                 impulse = np.array([float(push.group(2)), float(push.group(3))])
-                expected = np.array([8.0, -6.0]) * MODEL_MASS[model] / 60.0  # paper preset
-                np.testing.assert_allclose(impulse, expected, atol=0.06)
+                np.testing.assert_allclose(impulse, [8.0, -6.0], atol=0.06)  # preset, 60 kg
                 push_time = float(push.group(1))
                 try:
                     _, found = demo.wait_for_line(ADJUSTED_LINE, timeout=15, start=index)
@@ -194,8 +190,7 @@ def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory, model)
             dismiss_notifications(page)
             page.wait_for_timeout(4000)  # a few frames with the adjusted (red) step
             pixels = canvas_pixels(page)
-            if model == "pybullet":  # the README shows the robot
-                page.screenshot(path=str(SCREENSHOT))
+            page.screenshot(path=str(SCREENSHOT))
             assert pixels.mean(axis=2).var() > 100.0, "the 3-D view looks blank"
 
             # A click on the ground aims the push from the robot towards the point.
@@ -224,5 +219,12 @@ def test_robot_page_loads_with_pybullet(playwright_api, demo_factory):
             pixels = canvas_pixels(page).mean(axis=2)
             assert pixels.var() > 100.0, "the 3-D view looks blank"
             assert (pixels < 100.0).mean() > 0.002, "no robot-sized dark region rendered"
+            # Restart so the README picture shows the robot walking, whatever the
+            # page's load time was.
+            page.get_by_role("button", name="Reset", exact=True).click()
+            wait_for_status(page, r"t = [2-9]\.\d+ s")
+            dismiss_notifications(page)
+            page.wait_for_timeout(5000)
+            page.screenshot(path=str(ROBOT_SCREENSHOT))
         finally:
             context.close()
