@@ -96,10 +96,11 @@ from scipy.spatial.transform import Rotation
 from app.backend import FallStatus, InitialCondition
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
-from kinematics.com_plan import GRAVITY, ROTATION_90, lipm_integrate
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
+from planner.hybrid_lipm import H_MATRIX, integrate_lipm
+from planner.parameters import GRAVITY, LipmModel
 from planner.types import Foot, MeasuredState, PlannerOutput, Vector2, other_foot
 from robots import get_robot
 from robots.description import RobotDescription
@@ -261,6 +262,7 @@ class PyBulletBackend:
         self._ik_to_sim = [self.ik.joint_names.index(name) for name in self.sim.joint_names]
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
+        self._lipm = LipmModel(mass=self.mass, com_height=self.com_height)
         self.swing = SwingFootTrajectory(
             self.timing,
             apex_height=self.description.swing_height,
@@ -439,24 +441,24 @@ class PyBulletBackend:
         zmp = np.asarray(command.zmp, float)
         if self.momentum_compensation > 0.0:
             zmp, hdot = self._momentum_aware_pivot(command, zmp, hdot)
-        self._com_reference, self._com_velocity_reference = lipm_integrate(
+        self._com_reference, self._com_velocity_reference = integrate_lipm(
+            self._lipm,
             self._com_reference,
             self._com_velocity_reference,
             zmp,
             hdot,
-            self.mass,
-            self.com_height,
+            np.zeros(2),
             self.control_period,
         )
         if self.com_lookahead == 0.0:
             return self._com_reference + correction
-        target, _ = lipm_integrate(
+        target, _ = integrate_lipm(
+            self._lipm,
             self._com_reference,
             self._com_velocity_reference,
             zmp,
             hdot,
-            self.mass,
-            self.com_height,
+            np.zeros(2),
             self.com_lookahead,
         )
         return target + correction
@@ -472,9 +474,9 @@ class PyBulletBackend:
         uses that CoP as its ZMP and Ldot as its hdot.
         """
         weight = self.mass * GRAVITY
-        pivot = zmp - ROTATION_90 @ hdot / weight
+        pivot = zmp - H_MATRIX @ hdot / weight
         rate = self.momentum_compensation * self._ik_momentum_rate
-        wanted = pivot + ROTATION_90 @ rate / weight
+        wanted = pivot + H_MATRIX @ rate / weight
         sole = self.description.sole
         margin = self.cop_margin
         stance = np.asarray(command.stance.position, float)

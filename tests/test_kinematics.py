@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kinematics.com_plan import lipm_integrate
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
@@ -129,21 +128,3 @@ def test_smooth_swing_starts_without_acceleration_and_lands_on_target():
     assert first["smooth"] < 0.2 * first["cubic"]  # gentle lift-off
     assert np.allclose(smooth.position[:2], target, atol=1e-4)
     assert np.allclose(smooth.velocity, 0.0, atol=1e-3)
-
-
-def test_lipm_integration_matches_the_closed_form_and_includes_the_momentum():
-    com, velocity = np.array([0.02, -0.01]), np.array([0.1, 0.05])
-    zmp = np.zeros(2)
-    position, new_velocity = lipm_integrate(com, velocity, zmp, np.zeros(2), 30.0, 0.7, 0.0)
-    assert np.allclose(position, com) and np.allclose(new_velocity, velocity)
-    # Numerical integration of c_dd = g/c_z (c - p) + S hdot / (m c_z).
-    mass, height, hdot = 30.0, 0.7, np.array([5.0, -3.0])
-    state_position, state_velocity = com.copy(), velocity.copy()
-    rotation = np.array([[0.0, -1.0], [1.0, 0.0]])
-    for _ in range(10000):
-        acceleration = 9.81 / height * (state_position - zmp) + rotation @ hdot / (mass * height)
-        state_velocity = state_velocity + 1e-5 * acceleration
-        state_position = state_position + 1e-5 * state_velocity
-    position, new_velocity = lipm_integrate(com, velocity, zmp, hdot, mass, height, 0.1)
-    assert np.allclose(position, state_position, atol=1e-6)
-    assert np.allclose(new_velocity, state_velocity, atol=1e-5)
