@@ -90,17 +90,17 @@ from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
 from app.backend import FallStatus, InitialCondition
+from app.pybullet_com_plan import momentum_aware_pivot
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
-from planner.hybrid_lipm import H_MATRIX, integrate_lipm
-from planner.parameters import GRAVITY, LipmModel
+from planner.hybrid_lipm import integrate_lipm
+from planner.parameters import LipmModel
 from planner.types import Foot, MeasuredState, PlannerOutput, Vector2, other_foot
 from robots import get_robot
 from robots.description import RobotDescription
@@ -466,34 +466,17 @@ class PyBulletBackend:
     def _momentum_aware_pivot(
         self, command: PlannerOutput, zmp: NDArray[np.float64], hdot: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """ZMP and hdot of the CoM plan given the IK motion's own angular momentum rate.
-
-        The CoP that keeps the commanded pivot (ZMP - S hdot / (m g)) while the
-        motion produces Ldot is pivot + S Ldot / (m g); it is clipped to the stance
-        sole (both soles in a double support with a ramped plan). The CoM plan then
-        uses that CoP as its ZMP and Ldot as its hdot.
-        """
-        weight = self.mass * GRAVITY
-        pivot = zmp - H_MATRIX @ hdot / weight
-        rate = self.momentum_compensation * self._ik_momentum_rate
-        wanted = pivot + H_MATRIX @ rate / weight
-        sole = self.description.sole
-        margin = self.cop_margin
-        stance = np.asarray(command.stance.position, float)
-        low = stance + np.array([sole.x_min + margin, -sole.half_width + margin])
-        high = stance + np.array([sole.x_max - margin, sole.half_width - margin])
-        if command.double_support and self.plan_angular_momentum != "full":
-            old = np.asarray(command.previous_stance.position, float)
-            corners = np.array(
-                [
-                    foot + np.array([x, y])
-                    for foot in (stance, old)
-                    for x in (sole.x_min + margin, sole.x_max - margin)
-                    for y in (-sole.half_width + margin, sole.half_width - margin)
-                ]
-            )
-            return _clip_to_hull(wanted, corners), rate
-        return np.clip(wanted, low, high), rate
+        """ZMP and hdot of the CoM plan given the IK motion's own angular momentum rate."""
+        return momentum_aware_pivot(
+            zmp,
+            hdot,
+            self.momentum_compensation * self._ik_momentum_rate,
+            self.mass,
+            command,
+            self.description.sole,
+            self.cop_margin,
+            ramped_double_support=self.plan_angular_momentum != "full",
+        )
 
     def _measure(self) -> MeasuredState:
         com, com_velocity = self.sim.com_state()
@@ -538,23 +521,6 @@ class PyBulletBackend:
     def close(self) -> None:
         """Release the PyBullet client."""
         self.sim.close()
-
-
-def _clip_to_hull(point: NDArray[np.float64], corners: NDArray[np.float64]) -> NDArray[np.float64]:
-    """``point`` if inside the convex hull of ``corners`` (n x 2), else its nearest hull point."""
-    hull = ConvexHull(corners)
-    if np.all(hull.equations[:, :2] @ point + hull.equations[:, 2] <= 1e-12):
-        return point
-    best, best_distance = point, np.inf
-    for start, end in hull.simplices:
-        a, b = corners[start], corners[end]
-        edge = b - a
-        fraction = float(np.clip((point - a) @ edge / (edge @ edge), 0.0, 1.0))
-        candidate = a + fraction * edge
-        distance = float(np.linalg.norm(point - candidate))
-        if distance < best_distance:
-            best, best_distance = candidate, distance
-    return best
 
 
 def _ground_pose(position_xy: NDArray[np.float64]) -> NDArray[np.float64]:

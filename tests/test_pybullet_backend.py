@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from app.backend import InitialCondition
-from app.pybullet_backend import PyBulletBackend, _clip_to_hull
+from app.pybullet_backend import PyBulletBackend
+from app.pybullet_com_plan import clip_to_hull
 from planner.exceptions import ParameterError
 from planner.types import Foothold, PlannerOutput, StepEvent
 
@@ -143,9 +144,9 @@ def test_old_foot_is_lifted_after_the_step_and_the_cop_plan_stays_on_the_sole(ba
 def test_clip_to_hull_keeps_inside_points_and_projects_outside_ones():
     corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0], [2.0, 0.5]])
     inside = np.array([1.2, 0.5])
-    assert np.array_equal(_clip_to_hull(inside, corners), inside)
-    assert np.allclose(_clip_to_hull(np.array([0.5, -1.0]), corners), [0.5, 0.0])
-    assert np.allclose(_clip_to_hull(np.array([-1.0, 2.0]), corners), [0.0, 1.0])
+    assert np.array_equal(clip_to_hull(inside, corners), inside)
+    assert np.allclose(clip_to_hull(np.array([0.5, -1.0]), corners), [0.5, 0.0])
+    assert np.allclose(clip_to_hull(np.array([-1.0, 2.0]), corners), [0.0, 1.0])
 
 
 def test_same_commands_give_the_same_result():
