@@ -31,6 +31,16 @@ def _port(text: str) -> int:
     return value
 
 
+def _frame_rate(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--frame-rate={text!r}: expected a number") from None
+    if not 1.0 <= value <= 60.0:
+        raise argparse.ArgumentTypeError(f"--frame-rate={value}: expected 1 to 60 [Hz]")
+    return value
+
+
 def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Add ``demo`` to the subcommands ``sub`` of ``rsg``; returns its parser."""
     demo = sub.add_parser(
@@ -63,6 +73,13 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--host", default="127.0.0.1", help="address to serve on (default: 127.0.0.1)"
     )
     demo.add_argument("--port", type=_port, default=8080, help="port to serve on (default: 8080)")
+    demo.add_argument(
+        "--frame-rate",
+        type=_frame_rate,
+        default=40.0,
+        help="scene updates sent to the page per second, 1 to 60 (default: 40); lower it for "
+        "browsers without GPU rendering, which otherwise fall behind and answer clicks late",
+    )
     return demo
 
 

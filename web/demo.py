@@ -81,7 +81,7 @@ def main(args: argparse.Namespace) -> int:
                 file=sys.stderr,
             )
             return 2
-        page = DemoPage(server, live, urdf)
+        page = DemoPage(server, live, urdf, frame_rate=getattr(args, "frame_rate", 40.0))
         live.start()
         page.start()
         shown = "127.0.0.1" if args.host in ("0.0.0.0", "") else args.host

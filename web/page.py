@@ -101,6 +101,7 @@ class DemoPage:
         urdf: Derived URDF of the robot (absolute mesh paths) for the full robot, or
             None to draw the point-mass LIPM (CoM ball on a stick).
         log: Called with a line when the user aims by clicking (default: print).
+        frame_rate: Scene updates per second while the simulation runs [Hz].
     """
 
     def __init__(
@@ -109,8 +110,10 @@ class DemoPage:
         live: LiveSimulation,
         urdf: Path | None,
         log: Callable[[str], None] | None = None,
+        frame_rate: float = FRAME_RATE,
     ) -> None:
         self.server = server
+        self.frame_rate = frame_rate
         self._log = log or (lambda line: print(line, flush=True))
         self.live = live
         self._worker = Worker(self._run, "rsg-page")
@@ -342,7 +345,7 @@ class DemoPage:
         self._worker.stop(timeout)
 
     def _run(self, stop: threading.Event) -> None:
-        period = 1.0 / FRAME_RATE
+        period = 1.0 / self.frame_rate
         last = wallclock.perf_counter()
         while not stop.is_set():
             start = wallclock.perf_counter()
