@@ -155,13 +155,23 @@ class ReactiveStepGenerator:
         wait = max(self.reference.time_to_nominal_jump(), ready, 0.0)
         return wait if math.isfinite(wait) else max(ready, 0.0)
 
-    def preview_step(self, xi: np.ndarray, nominal_wait: float | None = None) -> np.ndarray:
+    def preview_step(
+        self,
+        xi: np.ndarray,
+        nominal_wait: float | None = None,
+        error: np.ndarray | None = None,
+    ) -> np.ndarray:
         """Where the next step would land [m], re-planned at each tick.
 
         With V_u >= gamma_v it is the QP (27) at the current state; otherwise the
         nominal step 2 xi1* at the reference's next (gated) nominal jump.
+
+        Args:
+            xi: (c_H - o_H, cdot_H) now.
+            nominal_wait: Time to the gated D_S [s], if already known.
+            error: e_u of ``xi``, if already known [m].
         """
-        error = self.dcm_error(xi)
+        error = self.dcm_error(xi) if error is None else error
         level = self.design.level(error)
         if self.config.adjusts_location and level >= self.design.threshold:
             step, _, _ = self._step_location(xi[:2], error, level, "exact")
@@ -242,7 +252,7 @@ class ReactiveStepGenerator:
             angular_momentum_rate_feedback=self.filter_state[2:].copy(),
             stance=Foothold(_foot_of(self.sigma), self.stance.copy()),
             previous_stance=Foothold(_foot_of(-self.sigma), self.previous.copy()),
-            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi, nominal_wait)),
+            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi, nominal_wait, error)),
             next_step_time=self.predicted_step_time(measured.time, level, nominal_wait),
             time_since_step=self.time_since_step,
             double_support=self.time_since_step < self.config.gait.double_support_duration,

@@ -21,24 +21,25 @@ Push from the page (button "Push", click the ground to aim). Ctrl-C stops the se
 """
 
 
-def _port(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--port={text!r}: expected an integer") from None
-    if not 1 <= value <= 65535:
-        raise argparse.ArgumentTypeError(f"--port={value}: expected a port in [1, 65535]")
-    return value
+def _bounded(option: str, kind: type, low: float, high: float, unit: str):  # noqa: ANN202
+    """An argparse type: a ``kind`` number in [low, high], with a message naming ``option``."""
+
+    def parse(text: str):  # noqa: ANN202
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"{option}={text!r}: expected a number in [{low}, {high}] {unit}"
+            ) from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"{option}={value}: expected [{low}, {high}] {unit}")
+        return value
+
+    return parse
 
 
-def _frame_rate(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--frame-rate={text!r}: expected a number") from None
-    if not 1.0 <= value <= 60.0:
-        raise argparse.ArgumentTypeError(f"--frame-rate={value}: expected 1 to 60 [Hz]")
-    return value
+_port = _bounded("--port", int, 1, 65535, "(a TCP port)")
+_frame_rate = _bounded("--frame-rate", float, 1.0, 60.0, "[Hz]")
 
 
 def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
