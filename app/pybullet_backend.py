@@ -145,6 +145,10 @@ class PyBulletBackend:
         smooth_swing: bool = False,
         landing_correction: float | tuple[float, float] = 0.0,
         landing_clearance: float = 0.0,
+        swing_acceleration: float | None = None,
+        swing_descent_slope: float = 0.0,
+        velocity_blend: float | None = None,
+        resync_at_step: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -201,6 +205,14 @@ class PyBulletBackend:
                 at the step the new stance sole target is lowered from it to the
                 ground over ``transfer_ramp`` (a foot commanded onto the ground
                 touches it early, see the module notes).
+            swing_acceleration: Bound on the swing sole's horizontal
+                acceleration when its target moves [m/s^2] (None: unbounded).
+            swing_descent_slope: The swing sole stays at least this many metres
+                up per metre still to go horizontally [-].
+            velocity_blend: Blend of the CoM velocity reference toward the
+                measured velocity [-] (None: ``com_reference_blend``).
+            resync_at_step: At each planner step the CoM reference is reset to
+                the measured CoM state.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -214,6 +226,10 @@ class PyBulletBackend:
             raise ParameterError("com_reference_blend", com_reference_blend, "in [0, 1]")
         self.com_lookahead = com_lookahead
         self.com_reference_blend = com_reference_blend
+        if velocity_blend is not None and not 0.0 <= velocity_blend <= 1.0:
+            raise ParameterError("velocity_blend", velocity_blend, "in [0, 1] or None")
+        self.velocity_blend = com_reference_blend if velocity_blend is None else velocity_blend
+        self.resync_at_step = resync_at_step
         self.com_tracking_gains = com_tracking_gains
         self.interpolate_targets = interpolate_targets
         if not (0.0 <= touchdown_lead <= 0.2 and 0.0 <= touchdown_depth <= 0.02):
@@ -269,6 +285,8 @@ class PyBulletBackend:
             arrival_lead=arrival_lead,
             touchdown_speed=touchdown_speed,
             smooth_horizontal=smooth_swing,
+            max_acceleration=swing_acceleration,
+            descent_slope=swing_descent_slope,
         )
         if not 0.0 <= landing_delay <= 0.05:
             raise ParameterError("landing_delay", landing_delay, "in [0, 0.05] s")
@@ -348,6 +366,9 @@ class PyBulletBackend:
             # The planner stepped: the old stance foot lifts off from where it stood.
             self.swing.start(np.asarray(command.previous_stance.position, float))
             self._stance = stance
+            if self.resync_at_step and self._measured is not None:
+                self._com_reference = np.asarray(self._measured.com_position, float).copy()
+                self._com_velocity_reference = np.asarray(self._measured.com_velocity, float).copy()
         com_target = self._advance_com_reference(command)
         time_since_step = command.time_since_step + dt
         # Optional touchdown before the planner's step (``touchdown_lead``); G1
@@ -432,7 +453,9 @@ class PyBulletBackend:
         )
         blend = self.com_reference_blend
         self._com_reference = self._com_reference - blend * position_error
-        self._com_velocity_reference = self._com_velocity_reference - blend * velocity_error
+        self._com_velocity_reference = (
+            self._com_velocity_reference - self.velocity_blend * velocity_error
+        )
         hdot = {
             "full": command.angular_momentum_rate,
             "feedback": command.angular_momentum_rate_feedback,

@@ -51,6 +51,7 @@ def planner_config_for(
             lqr_angular_momentum_scale=description.angular_momentum_rate_max,
             swing_preparation_time=description.swing_preparation_time,
             filter_time_constant=description.filter_time_constant,
+            step_reaction_time=description.step_reaction_time,
         ),
         controller=controller,
     )

@@ -25,6 +25,17 @@ bounded by ``max_speed``. A target that moves during the swing is thus tracked
 smoothly, and after arrival the foot follows it like a critically damped filter.
 The height changes at most ``max_vertical_speed`` per second, so a change of the
 landing time does not make the foot jump.
+
+Reactive steps (the planner moves the step earlier and the foothold away while the
+foot is in the air) need two more bounds, both off by default:
+
+* ``max_acceleration`` [m/s^2]: the horizontal horizon is at least
+  sqrt(6 d / a_max) for a distance d to go (the peak acceleration of a
+  rest-to-rest cubic), so a foothold that jumps away is reached with bounded
+  leg accelerations instead of within ``min_horizontal_time``;
+* ``descent_slope`` [-]: while the foot is d away from the target horizontally
+  it does not descend below ``descent_slope * d`` (it is never raised by it), so
+  it arrives from above instead of dragging over the ground.
 """
 
 from __future__ import annotations
@@ -105,6 +116,8 @@ class SwingFootTrajectory:
         ground_height: float = 0.0,
         touchdown_speed: float = 0.0,
         smooth_horizontal: bool = False,
+        max_acceleration: float | None = None,
+        descent_slope: float = 0.0,
     ) -> None:
         """Set the parameters.
 
@@ -121,6 +134,9 @@ class SwingFootTrajectory:
                 [m/s] (see :func:`swing_height`).
             smooth_horizontal: Re-plan a minimum-jerk quintic (continuous
                 acceleration, zero at lift-off) instead of a cubic.
+            max_acceleration: Bound [m/s^2] on the horizontal acceleration of
+                a re-planned approach (None: only ``min_horizontal_time``).
+            descent_slope: Height [m] kept per metre still to go horizontally.
         """
         if not 0.0 < apex_height < 0.5:
             raise ParameterError("apex_height", apex_height, "0 < h < 0.5 m")
@@ -141,6 +157,12 @@ class SwingFootTrajectory:
             raise ParameterError("touchdown_speed", touchdown_speed, "in [0, max_vertical_speed)")
         self.touchdown_speed = touchdown_speed
         self.smooth_horizontal = smooth_horizontal
+        if max_acceleration is not None and not max_acceleration > 0.0:
+            raise ParameterError("max_acceleration", max_acceleration, "> 0 m/s^2 or None")
+        if not 0.0 <= descent_slope <= 10.0:
+            raise ParameterError("descent_slope", descent_slope, "in [0, 10]")
+        self.max_acceleration = max_acceleration
+        self.descent_slope = descent_slope
         self.position = np.zeros(3)
         self.velocity = np.zeros(2)
         self.acceleration = np.zeros(2)
@@ -177,6 +199,9 @@ class SwingFootTrajectory:
         if time_since_step > timing.double_support:
             remaining = max(arrival - (time_since_step - dt), 0.0)
             horizon = max(remaining, self.min_horizontal_time, dt)
+            if self.max_acceleration is not None:
+                distance = float(np.linalg.norm(target - self.position[:2]))
+                horizon = max(horizon, float(np.sqrt(6.0 * distance / self.max_acceleration)))
             if self.smooth_horizontal:
                 position, velocity, acceleration = _quintic_step(
                     self.position[:2], self.velocity, self.acceleration, target, horizon, dt
@@ -203,6 +228,9 @@ class SwingFootTrajectory:
         )
         step_limit = self.max_vertical_speed * dt
         current = self.position[2] - self.ground_height
+        if self.descent_slope > 0.0 and time_since_step > timing.double_support:
+            to_go = float(np.linalg.norm(target - self.position[:2]))
+            height = max(height, min(current, self.descent_slope * to_go))
         self.position[2] = self.ground_height + float(
             np.clip(height, current - step_limit, current + step_limit)
         )

@@ -175,6 +175,9 @@ class RsgParameters:
         lqr_dcm_error_scale: e_max of Bryson's rule Q = I / e_max^2 [m].
         lqr_zmp_scale: p~ scale of R, R_p = 1 / p_max^2 [m].
         lqr_angular_momentum_scale: hdot scale of R, R_h = 1 / h_max^2 [N m].
+        step_reaction_time: Time [s] between the timing jump's decision (D_T) and
+            the touchdown, for a robot whose swing foot needs time to reach a new
+            foothold; 0 (the paper): the step is taken the tick D_T fires.
     """
 
     filter_time_constant: float = 0.05
@@ -186,8 +189,11 @@ class RsgParameters:
     lqr_dcm_error_scale: float = 0.05
     lqr_zmp_scale: float = 0.05
     lqr_angular_momentum_scale: float = 20.0
+    step_reaction_time: float = 0.0
 
     def __post_init__(self) -> None:
+        if not 0.0 <= self.step_reaction_time <= 1.0:
+            raise ParameterError("step_reaction_time", self.step_reaction_time, "in [0, 1] s")
         _check_positive(
             self,
             "filter_time_constant",

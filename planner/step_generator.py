@@ -29,6 +29,19 @@ Two departures from the paper, both documented in the README:
 D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
 early step the reference may reach D_S sooner, before a real swing foot could land.
 
+One addition for a robot with legs, ``RsgParameters.step_reaction_time`` Delta
+(0, the default, is exactly the paper). The model's jump is instantaneous; a real
+swing foot needs time to reach a foothold the QP has moved. With Delta > 0, D_T is
+evaluated Delta ahead (s~ + Delta >= T_DSP + T_SP) and, when it fires, schedules the
+touchdown at s~_td = max(s~ + Delta, T_DSP + T_SP): the decision is kept (even if
+V_u dips below gamma_v meanwhile, else the announced foothold flips between the
+QP's and the nominal one as V_u crosses gamma_v), ``next_step_time`` announces
+s~_td, and ``next_step`` is the QP (27) solved at the state predicted at s~_td (the
+LIPM under the current input, the reference flowing freely), re-solved every tick
+as s~_td approaches. At s~_td the jump happens with the QP at that tick's state, as
+in the paper. The touchdown time is fixed when the decision is made, so the
+foothold converges as the prediction horizon shrinks.
+
 Controllers in the same framework (``PlannerConfig.controller``):
 
 - ``rsg``: all of the above;
@@ -43,7 +56,7 @@ import math
 
 import numpy as np
 
-from .hybrid_lipm import H_INVERSE, dcm, flow_autonomous
+from .hybrid_lipm import H_INVERSE, dcm, flow_autonomous, integrate_lipm
 from .lyapunov import LyapunovDesign, design_lyapunov
 from .parameters import PlannerConfig
 from .reference_model import NominalOrbit, ReferenceModel
@@ -98,6 +111,8 @@ class ReactiveStepGenerator:
         self.lyapunov_at_step = 0.0  # V_u^dagger
         self.filter_state = np.zeros(4)  # zeta = filtered sat(K_u e_u) = (p~, hdot_fb)
         self.compensation_state = np.zeros(2)  # filtered m g H^-1 r~_H [N m]
+        self.scheduled_step: float | None = None  # s~ of a decided timing jump
+        self.announced_step: np.ndarray | None = None  # its foothold, last announced [m]
         self.reference = ReferenceModel(self.orbit, self.sigma, s0)
 
     def initial_com_state(self) -> tuple[np.ndarray, np.ndarray]:
@@ -117,29 +132,66 @@ class ReactiveStepGenerator:
         """e_u (18) [m]."""
         return dcm(self.omega, xi) - self.reference.dcm()
 
-    def _ready_to_step(self) -> bool:
+    def _ready_to_step(self, lead: float = 0.0) -> bool:
+        """s~ + ``lead`` >= T_DSP + T_SP."""
         gait, rsg = self.config.gait, self.config.rsg
-        return self.time_since_step >= gait.double_support_duration + rsg.swing_preparation_time
+        ready = gait.double_support_duration + rsg.swing_preparation_time
+        return self.time_since_step + lead >= ready - 1e-9
 
     def _timing_jump(self, xi1: np.ndarray, level: float) -> bool:
-        """D_T: the step time is adjusted (only for ``rsg``)."""
-        if not self.config.adjusts_timing or not self._ready_to_step():
+        """D_T, evaluated ``step_reaction_time`` ahead (only for ``rsg``)."""
+        lead = self.config.rsg.step_reaction_time
+        if not self.config.adjusts_timing or not self._ready_to_step(lead):
             return False
         gamma, mu1 = self.design.threshold, self.config.rsg.step_decrease_margin
         d_t1 = level >= gamma and level - self.lyapunov_at_step >= -gamma + mu1
         d_t2 = self.sigma * xi1[1] - self.config.constraints.half_width >= 0.0
         return bool(d_t1 or d_t2)
 
+    def _schedule(self, xi1: np.ndarray, level: float) -> bool:
+        """Decide a timing jump (D_T) if none is scheduled; True when it is due now."""
+        if self.scheduled_step is None and self._timing_jump(xi1, level):
+            gait, rsg = self.config.gait, self.config.rsg
+            ready = gait.double_support_duration + rsg.swing_preparation_time
+            self.scheduled_step = max(self.time_since_step + rsg.step_reaction_time, ready)
+        due = self.scheduled_step
+        return due is not None and self.time_since_step >= due - 1e-9
+
+    def predict(self, xi: np.ndarray, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """State, DCM error and xi1* predicted ``delay`` [s] ahead, before any jump.
+
+        The LIPM flows under the current (filtered) input, the reference freely (13a).
+        """
+        if delay <= 0.0:
+            return xi, self.dcm_error(xi), self.reference.xi1.copy()
+        zmp = self.filter_state[:2] + self.window_offset()
+        hdot = self.filter_state[2:] + self.compensation_state
+        com, velocity = integrate_lipm(self.model, xi[:2], xi[2:], zmp, hdot, np.zeros(2), delay)
+        predicted = np.concatenate([com, velocity])
+        reference = flow_autonomous(self.omega, self.reference.state, delay)
+        error = dcm(self.omega, predicted) - dcm(self.omega, reference)
+        return predicted, error, reference[:2].copy()
+
     def _step_location(
-        self, xi1: np.ndarray, error: np.ndarray, level: float, solver: str
+        self,
+        xi1: np.ndarray,
+        error: np.ndarray,
+        level: float,
+        solver: str,
+        reference_xi1: np.ndarray | None = None,
     ) -> tuple[np.ndarray, bool, bool]:
-        """u_d of the output map H_nu; returns (u_d, from_qp, qp_feasible)."""
-        if self.config.adjusts_location and level >= self.design.threshold:
+        """u_d of the output map H_nu; returns (u_d, from_qp, qp_feasible).
+
+        The QP is used while V_u >= gamma_v and for a scheduled timing jump;
+        ``reference_xi1`` is xi1* at the step (default: now).
+        """
+        use_qp = level >= self.design.threshold or self.scheduled_step is not None
+        if self.config.adjusts_location and use_qp:
             problem = build_step_qp(
                 self.design.matrix,
                 error,
                 xi1,
-                self.reference.xi1,
+                self.reference.xi1 if reference_xi1 is None else reference_xi1,
                 self.sigma,
                 self.config.constraints,
                 self.config.rsg,
@@ -173,6 +225,14 @@ class ReactiveStepGenerator:
         """
         error = self.dcm_error(xi) if error is None else error
         level = self.design.level(error)
+        if self.scheduled_step is not None and self.config.adjusts_location:
+            delay = self.scheduled_step - self.time_since_step
+            predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
+            step, _, _ = self._step_location(
+                predicted[:2], predicted_error, level, "exact", reference_xi1
+            )
+            self.announced_step = self.stance + step
+            return self.announced_step.copy()
         if self.config.adjusts_location and level >= self.design.threshold:
             step, _, _ = self._step_location(xi[:2], error, level, "exact")
             return self.stance + step
@@ -189,10 +249,13 @@ class ReactiveStepGenerator:
         swing foot can land (s~ = T_DSP + T_SP) or now if that is past; otherwise
         the step comes when the reference reaches D_S.
         """
+        if self.scheduled_step is not None:
+            return time + max(self.scheduled_step - self.time_since_step, 0.0)
         if self.config.adjusts_timing and level >= self.design.threshold:
             gait, rsg = self.config.gait, self.config.rsg
             earliest = gait.double_support_duration + rsg.swing_preparation_time
-            return time + max(earliest - self.time_since_step, 0.0)
+            wait = max(earliest - self.time_since_step, rsg.step_reaction_time, 0.0)
+            return time + wait
         return time + (self._nominal_wait() if nominal_wait is None else nominal_wait)
 
     # ------------------------------------------------------------ one tick
@@ -213,10 +276,19 @@ class ReactiveStepGenerator:
 
         step_event: StepEvent | None = None
         qp_infeasible = False
-        timing = self._timing_jump(xi[:2], level)
-        nominal = self._ready_to_step() and self.reference.in_nominal_jump_set()
+        timing = self._schedule(xi[:2], level)
+        # A scheduled timing jump keeps its time: the swing foot is on its way there.
+        nominal = (
+            self.scheduled_step is None
+            and self._ready_to_step()
+            and self.reference.in_nominal_jump_set()
+        )
         if timing or nominal:
-            u_d, from_qp, feasible = self._step_location(xi[:2], error, level, self.qp_solver)
+            if timing and self.announced_step is not None:
+                # The swing foot was sent to the foothold announced last tick: it lands there.
+                u_d, from_qp, feasible = self.announced_step - self.stance, True, True
+            else:
+                u_d, from_qp, feasible = self._step_location(xi[:2], error, level, self.qp_solver)
             qp_infeasible = not feasible
             window_now = self.stance + self.window_offset()
             self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)
@@ -225,6 +297,8 @@ class ReactiveStepGenerator:
             self.sigma = -self.sigma
             self.window_start = window_now
             self.time_since_step = 0.0
+            self.scheduled_step = None
+            self.announced_step = None
             self.reference.jump()
             step_event = StepEvent(
                 time=measured.time,

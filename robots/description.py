@@ -101,6 +101,9 @@ class RobotDescription:
             support before it can land [s] (bounds how early the planner may step).
         filter_time_constant: theta, the planner's low-pass filter on its
             continuous input and double-support compensation [s].
+        step_reaction_time: Time [s] the swing foot needs between the planner's
+            decision to step early and the touchdown
+            (``RsgParameters.step_reaction_time``).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         backend_options: Keyword arguments of the PyBullet backend tuned for
@@ -135,6 +138,7 @@ class RobotDescription:
     lqr_dcm_error_scale: float = 0.03
     swing_preparation_time: float = 0.2
     filter_time_constant: float = 0.05
+    step_reaction_time: float = 0.0
     sole_box_collision: bool = False
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 

@@ -112,6 +112,7 @@ G1 = RobotDescription(
     sole_box_collision=True,
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
+    step_reaction_time=0.2,
     backend_options={
         "com_reference_blend": 0.05,
         "com_tracking_gains": (1.0, 0.0),
@@ -121,5 +122,7 @@ G1 = RobotDescription(
         "cop_margin": 0.0,
         "landing_correction": 1.0,
         "landing_clearance": 0.002,
+        "swing_acceleration": 20.0,
+        "swing_descent_slope": 0.5,
     },
 )
