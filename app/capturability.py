@@ -33,17 +33,30 @@ the range is [u_x^m, u_x^M] for both feet.
 
 The 2-D capturable set lies inside the product of the two 1-D intervals (each
 axis alone, with its own free timing, is a relaxation of the coupled problem), so
-the box [a_N, b_N]^2 is an upper bound; it is exact for pushes along an axis. The
-first step of the push comes at t_1 = max(0, T_min - s~) after the push start (s~:
-time since the last step at the push), later ones every T_min.
+the box [a_N, b_N]^2 is an upper bound; it is exact for pushes along an axis.
 
 Impulse: during a push of force f over Delta, xidot = omega (xi - r) + f / (m omega).
 For all times after the push, the state equals that of an instantaneous DCM jump at
 the push start of i / (m omega) * kappa, kappa = (1 - e^(-omega Delta)) / (omega
-Delta) (-> 1 for a short push); since capturability is decided by the state after the
-push, the bound is exact for the finite push too. The largest impulse along unit
-direction d is s* m omega / kappa, with s* the largest s such that x0 + s d stays in
-the capture box, x0 the nominal DCM at the push.
+Delta) (-> 1 for a short push), under the same CMP and steps (the DCM is linear in
+f and the step is a shift of the frame). The largest impulse along unit direction d
+is s* m omega / kappa, with s* the largest s such that x0 + s d stays in the capture
+box, x0 the nominal DCM at the push.
+
+When the first step may come: t_1 = max(T_min - s~, Delta) after the push start
+(s~: time since the last step at the push), later ones every T_min. T_min - s~ is
+the swing foot's readiness, measured from the last touchdown as the controller's
+gate s~ >= T_DSP + T_SP. The Delta is causality: the equivalent jump above lumps
+the whole impulse at the push start, but a controller measures the push only as it
+acts (its size and end are unknown beforehand), so a step before the push ends
+would be placed for an impulse not yet applied. A bound that lets the first step
+land at the push start, placed for the whole impulse (t_1 = max(0, T_min - s~), an
+earlier version), is a bound for a controller that knows the push in advance: at
+phases with s~ >= T_min it was 30-40% above what any causal controller can reach
+(e.g. 255 instead of 187 N s forward at phase 0.5). Between the push start and t_1
+the CMP may sit anywhere in its window (the push direction is measured from its
+first instant), which the per-axis box already allows. For s~ <= T_min - Delta
+(phases 0 and 0.25 of the default gait) the two forms agree.
 
 CMP window: by default the window is the ZMP window widened by the feedback rate of
 change of angular momentum, |hdot| <= hdot_max shifts the CMP by up to
@@ -219,6 +232,11 @@ def push_discount(omega: float, push_duration: float) -> float:
     return 1.0 if x < 1e-9 else (1.0 - math.exp(-x)) / x
 
 
+def first_step_time(min_step_time: float, time_since_step: float, push_duration: float) -> float:
+    """Earliest first step after the push start [s]: the swing foot ready, the push over."""
+    return max(min_step_time - time_since_step, push_duration, 0.0)
+
+
 def nominal_dcm(config: PlannerConfig, sigma: int, time_since_step: float) -> np.ndarray:
     """DCM relative to the stance ankle on the nominal orbit [m]."""
     orbit = NominalOrbit(config.model.omega, config.gait)
@@ -247,7 +265,7 @@ def impulse_bound(
         include_angular_momentum: Widen the window by hdot_max / (m g).
     """
     model = CaptureModel.from_config(config, include_angular_momentum)
-    first = max(0.0, model.min_step_time - time_since_step)
+    first = first_step_time(model.min_step_time, time_since_step, push_duration)
     lo, hi = capture_box(model, sigma, first, n_steps)
     x0 = nominal_dcm(config, sigma, time_since_step)
     shift = max_dcm_shift(x0, np.array([math.cos(angle), math.sin(angle)]), lo, hi)

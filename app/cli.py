@@ -115,6 +115,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="simulated time [s] (default: the scenario's)",
     )
     run.add_argument("--out", type=Path, required=True, help="folder for the results")
+    run.add_argument(
+        "--paper-rules",
+        action="store_true",
+        help="LIPM controllers without the documented extensions (push hold, leg reach in "
+        "the step QP): the paper's jump set and QP (27) as printed",
+    )
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     for command in plugin_commands().values():

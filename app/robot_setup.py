@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 from planner.parameters import (
     Constraints,
     GaitParameters,
@@ -44,6 +46,7 @@ def planner_config_for(
             angular_momentum_rate_max=description.angular_momentum_rate_max,
             step_min=description.step_min,
             step_max=description.step_max,
+            com_reach=math.inf,  # the LIPM extensions are validated on the LIPM only
         ),
         rsg=RsgParameters(
             lqr_dcm_error_scale=description.lqr_dcm_error_scale,
@@ -52,6 +55,7 @@ def planner_config_for(
             swing_preparation_time=description.swing_preparation_time,
             filter_time_constant=description.filter_time_constant,
             step_reaction_time=description.step_reaction_time,
+            push_hold_time=0.0,  # the paper's D_T: no push estimate from the robot's CoM
         ),
         controller=controller,
     )

@@ -74,7 +74,9 @@ def run_command(args: argparse.Namespace) -> int:
 
         backend, config, initial, planner = build_placo_wpg_backend(args.robot)
     else:
-        backend, config, initial = build_backend(args.model, args.robot, args.controller)
+        backend, config, initial = build_backend(
+            args.model, args.robot, args.controller, args.paper_rules
+        )
     try:
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:

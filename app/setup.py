@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import math
+from dataclasses import replace
+
 from planner.exceptions import ParameterError
 from planner.parameters import PlannerConfig
 
@@ -10,19 +13,37 @@ from .lipm_backend import LipmBackend
 from .runner import walking_start
 
 
+def paper_rules(config: PlannerConfig) -> PlannerConfig:
+    """``config`` without the documented extensions: the paper's D_T and (27) as printed
+    (no push hold, ``push_hold_time = 0``; no step reaction time,
+    ``step_reaction_time = 0``; no leg reach in the QP, ``com_reach = inf``)."""
+    return replace(
+        config,
+        rsg=replace(config.rsg, push_hold_time=0.0, step_reaction_time=0.0),
+        constraints=replace(config.constraints, com_reach=math.inf),
+    )
+
+
 def build_backend(
-    model: str, robot: str, controller: str
+    model: str, robot: str, controller: str, paper: bool = False
 ) -> tuple[Backend, PlannerConfig, InitialCondition]:
     """The backend for ``model`` and the planner configuration that fits it.
+
+    Args:
+        model, robot, controller: Names as on the command line.
+        paper: The paper's rules only (:func:`paper_rules`).
 
     Raises:
         ParameterError: Unknown model or robot.
     """
     if model == "lipm":
         config = PlannerConfig(controller=controller)
+        if paper:
+            config = paper_rules(config)
         return LipmBackend(config.model), config, walking_start(config)
     if model == "pybullet":
         from .robot_setup import build_robot_backend
 
-        return build_robot_backend(robot, controller)
+        backend, config, initial = build_robot_backend(robot, controller)
+        return backend, paper_rules(config) if paper else config, initial
     raise ParameterError("--model", model, "lipm or pybullet")

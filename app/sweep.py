@@ -48,7 +48,7 @@ JOBS_FILE = "jobs.jsonl"
 SPEC_FILE = "sweep_spec.json"
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
-                 "qp_solver", "criterion", "fall_dcm_error")  # fmt: skip
+                 "qp_solver", "criterion", "fall_dcm_error", "paper_rules")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -72,6 +72,8 @@ class SweepSpec:
             backend's own default (0.5 m) is a heuristic below the capturable DCM
             error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
+        paper_rules: LIPM controllers without the documented extensions (push hold,
+            leg reach in the QP; :func:`app.setup.paper_rules`).
     """
 
     model: str = "lipm"
@@ -87,6 +89,7 @@ class SweepSpec:
     qp_solver: str = "exact"
     criterion: str = "recovered"
     fall_dcm_error: float = 2.0
+    paper_rules: bool = False
 
     def __post_init__(self) -> None:
         if self.model not in ("lipm", "pybullet"):
@@ -159,7 +162,7 @@ def _build_job(spec: SweepSpec, controller: str):  # noqa: ANN202
 def _build_rsg(spec: SweepSpec, controller: str):  # noqa: ANN202
     from .setup import build_backend
 
-    backend, config, initial = build_backend(spec.model, spec.robot, controller)
+    backend, config, initial = build_backend(spec.model, spec.robot, controller, spec.paper_rules)
     if spec.model == "lipm":
         from .lipm_backend import LipmBackend
 
@@ -258,8 +261,9 @@ def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
     spec_path = out / SPEC_FILE
     if spec_path.is_file():
         old = json.loads(spec_path.read_text())
-        for name in RESULT_FIELDS:
-            if old.get(name) != asdict(spec)[name]:
+        defaults = asdict(SweepSpec())
+        for name in RESULT_FIELDS:  # a field missing from an older spec had its default
+            if old.get(name, defaults[name]) != asdict(spec)[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",
                     old.get(name),

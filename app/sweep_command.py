@@ -72,6 +72,12 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tolerance", type=float, default=0.25, help="bisection [N s] (0.25)")
     p.add_argument("--criterion", choices=("recovered", "no-fall"), default=None,
                    help="recovered (lipm default) or no-fall (pybullet default)")  # fmt: skip
+    p.add_argument(
+        "--paper-rules",
+        action="store_true",
+        help="LIPM controllers without the documented extensions (push hold, leg reach in "
+        "the step QP): the paper's jump set and QP (27) as printed",
+    )
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
     p.add_argument("--backend", choices=("process", "ray"), default="process",
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
@@ -102,6 +108,7 @@ def sweep_command(args: argparse.Namespace) -> int:
         settle=args.settle,
         tolerance=args.tolerance,
         criterion=criterion,
+        paper_rules=args.paper_rules,
     )
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()

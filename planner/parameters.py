@@ -15,8 +15,8 @@ that class:
 - step bounds u_d: x in [-0.4, 0.6] m, y in [-0.6, 0.6] m.
 
 With these values and gamma_v = 0.0015, the paper's Fig. 6 behaviour holds: the
-first push drives V_u to about 2.4 gamma_v (adjusted step), the second to about
-0.9 gamma_v (no adjusted step).
+first push drives V_u to about 1.4 gamma_v by its end (adjusted step), the second
+to about 0.9 gamma_v (no adjusted step).
 """
 
 from __future__ import annotations
@@ -114,6 +114,11 @@ class Constraints:
         angular_momentum_rate_max: Bound on |hdot| per axis [N m].
         step_min: u_d^m, lower bound of the step u_d = o_H^+ - o_H [m].
         step_max: u_d^M, upper bound of the step [m].
+        com_reach: Leg reach: the largest horizontal CoM distance from the new
+            stance ankle a QP step may leave, |xi1^+| <= com_reach [m] (an extension
+            of (27), see :mod:`planner.step_qp`); ``math.inf`` turns it off (the
+            paper's (27)). The default stays 2 cm inside the LIPM backend's fall
+            rule (CoM within 0.6 m of the stance ankle).
     """
 
     zmp_window_min: tuple[float, float] = (-0.08, -0.07)
@@ -121,8 +126,11 @@ class Constraints:
     angular_momentum_rate_max: float = 20.0
     step_min: tuple[float, float] = (-0.4, -0.6)
     step_max: tuple[float, float] = (0.6, 0.6)
+    com_reach: float = 0.58
 
     def __post_init__(self) -> None:
+        if not (self.com_reach > 0.0):
+            raise ParameterError("com_reach", self.com_reach, "a number > 0 (inf: off)")
         for name in ("zmp_window_min", "zmp_window_max", "step_min", "step_max"):
             value = getattr(self, name)
             if len(value) != 2 or not all(math.isfinite(v) for v in value):
@@ -178,6 +186,11 @@ class RsgParameters:
         step_reaction_time: Time [s] between the timing jump's decision (D_T) and
             the touchdown, for a robot whose swing foot needs time to reach a new
             foothold; 0 (the paper): the step is taken the tick D_T fires.
+        push_hold_time: Longest time [s] D_T,1 is held back while a push is measured
+            (an extension, see :mod:`planner.step_generator`); 0 gives the paper's
+            jump set exactly.
+        push_cmp_threshold: Size of the estimated push, as the CMP shift
+            |f| c_z / (m g) it causes [m], above which a push counts as under way.
     """
 
     filter_time_constant: float = 0.05
@@ -190,10 +203,12 @@ class RsgParameters:
     lqr_zmp_scale: float = 0.05
     lqr_angular_momentum_scale: float = 20.0
     step_reaction_time: float = 0.0
+    push_hold_time: float = 0.15
+    push_cmp_threshold: float = 0.02
 
     def __post_init__(self) -> None:
-        if not 0.0 <= self.step_reaction_time <= 1.0:
-            raise ParameterError("step_reaction_time", self.step_reaction_time, "in [0, 1] s")
+        _check_range("step_reaction_time", self.step_reaction_time, 0.0, 1.0)
+        _check_range("push_hold_time", self.push_hold_time, 0.0, 1.0)
         _check_positive(
             self,
             "filter_time_constant",
@@ -205,6 +220,7 @@ class RsgParameters:
             "lqr_dcm_error_scale",
             "lqr_zmp_scale",
             "lqr_angular_momentum_scale",
+            "push_cmp_threshold",
         )
 
 

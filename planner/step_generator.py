@@ -29,7 +29,27 @@ Two departures from the paper, both documented in the README:
 D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
 early step the reference may reach D_S sooner, before a real swing foot could land.
 
-One addition for a robot with legs, ``RsgParameters.step_reaction_time`` Delta
+A documented extension (``RsgParameters.push_hold_time``; 0 restores the paper's
+D_T exactly):
+
+- Push hold. D_T,1 is held back while a push is measured, for at most
+  ``push_hold_time`` (0.15 s). Once the swing foot is ready (s~ >= T_DSP + T_SP,
+  e.g. a push in the second half of single support), D_T,1 fires as soon as V_u
+  reaches gamma_v, 10-15 ms into a push, and the QP then places the step for the
+  still-small DCM error; the next step must wait T_DSP + T_SP while the push goes
+  on (on the LIPM, 0.27-0.49 of the capturability bound at phases 0.5 and 0.75 of
+  the cycle against 0.79-0.94 at phases 0 and 0.25). The push is estimated from
+  the measured DCM: over one period with constant inputs the LIPM gives
+  xi(t + T) = p + (xi(t) - p) e^(omega T), with p = p_cmd - f c_z / (m g) the
+  effective CMP, so f c_z / (m g) = p_cmd - p from the DCMs of two ticks (exact on
+  the LIPM, one tick late). While its size is at least ``push_cmp_threshold``
+  (2 cm, about 15 N at 60 kg) the step waits; when the push ends, the QP (27)
+  sees the whole DCM error. ``push_hold_time`` caps the delay for a push that lasts.
+  D_T,2 (the CoM past the outer edge of the foot) and D_S are not held. Without a
+  push the estimate is zero and nothing changes. Robots in PyBullet keep the
+  paper's D_T (:mod:`app.robot_setup`): the estimate there is not validated.
+
+Another, for a robot with legs, ``RsgParameters.step_reaction_time`` Delta
 (0, the default, is exactly the paper). The model's jump is instantaneous; a real
 swing foot needs time to reach a foothold the QP has moved. With Delta > 0, D_T is
 evaluated Delta ahead (s~ + Delta >= T_DSP + T_SP) and, when it fires, schedules the
@@ -56,7 +76,7 @@ import math
 
 import numpy as np
 
-from .hybrid_lipm import H_INVERSE, dcm, flow_autonomous, integrate_lipm
+from .hybrid_lipm import H_INVERSE, H_MATRIX, dcm, flow_autonomous, integrate_lipm
 from .lyapunov import LyapunovDesign, design_lyapunov
 from .parameters import PlannerConfig
 from .reference_model import NominalOrbit, ReferenceModel
@@ -114,6 +134,11 @@ class ReactiveStepGenerator:
         self.scheduled_step: float | None = None  # s~ of a decided timing jump
         self.announced_step: np.ndarray | None = None  # its foothold, last announced [m]
         self.reference = ReferenceModel(self.orbit, self.sigma, s0)
+        self._last_dcm: np.ndarray | None = None  # measured DCM at the last tick (world)
+        self._last_cmp = np.zeros(2)  # effective CMP commanded over the last period
+        self._last_period = 0.0
+        self.push_estimate = np.zeros(2)  # f c_z / (m g): CMP shift by the push [m]
+        self.push_duration = 0.0  # time the estimate has been above the threshold [s]
 
     def initial_com_state(self) -> tuple[np.ndarray, np.ndarray]:
         """CoM position and velocity [m], [m/s] of the reference at the current state."""
@@ -138,6 +163,27 @@ class ReactiveStepGenerator:
         ready = gait.double_support_duration + rsg.swing_preparation_time
         return self.time_since_step + lead >= ready - 1e-9
 
+    def _estimate_push(self, dcm_world: np.ndarray) -> None:
+        """Update the push estimate from the DCM measured now and at the last tick.
+
+        Over one period with constant inputs, (1) gives xi(t + T) = p + (xi(t) - p)
+        e^(omega T) with p the effective CMP, p = p_cmd - f c_z / (m g) (p_cmd the
+        commanded ZMP shifted by the commanded hdot). Solving for p from the two
+        measured DCMs gives f c_z / (m g) = p_cmd - p, exact on the LIPM.
+        """
+        if self._last_dcm is not None and self._last_period > 0.0:
+            growth = math.exp(self.omega * self._last_period)
+            cmp_measured = (dcm_world - growth * self._last_dcm) / (1.0 - growth)
+            self.push_estimate = self._last_cmp - cmp_measured
+            pushed = np.linalg.norm(self.push_estimate) >= self.config.rsg.push_cmp_threshold
+            self.push_duration = self.push_duration + self._last_period if pushed else 0.0
+        self._last_dcm = dcm_world.copy()
+
+    def holding_for_push(self) -> bool:
+        """Whether D_T,1 is held back: a push is under way, for less than T_hold."""
+        hold = self.config.rsg.push_hold_time
+        return hold > 0.0 and 0.0 < self.push_duration < hold
+
     def _timing_jump(self, xi1: np.ndarray, level: float) -> bool:
         """D_T, evaluated ``step_reaction_time`` ahead (only for ``rsg``)."""
         lead = self.config.rsg.step_reaction_time
@@ -145,6 +191,7 @@ class ReactiveStepGenerator:
             return False
         gamma, mu1 = self.design.threshold, self.config.rsg.step_decrease_margin
         d_t1 = level >= gamma and level - self.lyapunov_at_step >= -gamma + mu1
+        d_t1 = d_t1 and not self.holding_for_push()
         d_t2 = self.sigma * xi1[1] - self.config.constraints.half_width >= 0.0
         return bool(d_t1 or d_t2)
 
@@ -271,6 +318,7 @@ class ReactiveStepGenerator:
         """
         com = np.asarray(measured.com_position, dtype=float)
         xi = np.concatenate([com - self.stance, np.asarray(measured.com_velocity, dtype=float)])
+        self._estimate_push(com + xi[2:] / self.omega)
         error = self.dcm_error(xi)
         level = self.design.level(error)
 
@@ -337,6 +385,10 @@ class ReactiveStepGenerator:
             step=step_event,
             qp_infeasible=qp_infeasible,
         )
+        self._last_cmp = output.zmp - H_MATRIX @ angular_momentum_rate / (
+            self.model.mass * self.model.gravity
+        )
+        self._last_period = period
         self._flow(error, window_offset, period)
         return output
 

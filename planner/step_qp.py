@@ -14,6 +14,16 @@ above they say what Section III-B states in words: the new foot lands at least
 2 w_y + mu_2 on its own side of the old one, and the CoM stays inside the outer edge
 of the new stance foot.
 
+Leg reach (an extension, ``Constraints.com_reach``; ``math.inf`` gives (27) as
+printed): the step also keeps the CoM within reach of the new stance ankle,
+|xi1^+| = |xi1 - u_d| <= com_reach. The box (27d) lets a diagonal step reach
+0.85 m, and the V_u-optimal step for a large diagonal push leaves the CoM more than
+the 0.6 m leg reach of the LIPM backend from the new ankle (a fall there), where a
+slightly shorter step and a small residual error recover. The disc is convex; the
+box optimum is kept when it meets it, otherwise the optimum lies on the reach circle
+inside the box (:func:`_solve_on_reach_circle`). If no allowed step meets the reach,
+the box optimum is kept.
+
 Infeasibility: (27b)-(27d) reduce to a box on u_d. (27c) can make it empty when the
 CoM is already beyond where the largest lateral step can reach. The documented
 fallback is then to drop (27c) and take the step that minimises V_u within (27b),
@@ -23,6 +33,7 @@ fallback is then to drop (27c) and take the step that minimises V_u within (27b)
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,6 +64,8 @@ class StepQpProblem:
     lower: np.ndarray
     upper: np.ndarray
     com_row: int = 1
+    reach_center: np.ndarray | None = None
+    reach: float = math.inf
 
     def objective(self, step: np.ndarray) -> float:
         """V_u(e_u^+) for the step u_d."""
@@ -78,7 +91,15 @@ class StepQpProblem:
             self.lower,
             self.upper,
             com_row=-1,
+            reach_center=self.reach_center,
+            reach=self.reach,
         )
+
+    def reach_violation(self, step: np.ndarray) -> float:
+        """|xi1 - u_d| - com_reach [m] (<= 0 when the CoM stays within reach)."""
+        if self.reach_center is None or not math.isfinite(self.reach):
+            return -math.inf
+        return float(np.linalg.norm(self.reach_center - np.asarray(step, dtype=float)) - self.reach)
 
     def box(self) -> tuple[np.ndarray, np.ndarray]:
         """The feasible set as a box [lo, hi] (it is one: (27b), (27c) bound u_d,y only)."""
@@ -152,6 +173,8 @@ def build_step_qp(
         lower=np.array(constraints.step_min, dtype=float),
         upper=np.array(constraints.step_max, dtype=float),
         com_row=1,
+        reach_center=np.asarray(xi1, dtype=float).copy(),
+        reach=constraints.com_reach,
     )
 
 
@@ -244,4 +267,55 @@ def solve_step_qp(problem: StepQpProblem, solver: str = "proxqp") -> StepQpSolut
         step = solve_with_qpsolvers(to_solve, solver)
     if step is None:
         raise StepQpError("the step QP (27) without (27c) has no solution", to_solve)
+    if to_solve.reach_violation(step) > 0.0:
+        step = _solve_on_reach_circle(to_solve, step)
     return StepQpSolution(step=step, lyapunov_after=problem.objective(step), feasible=feasible)
+
+
+REACH_SAMPLES = 1440  # points on the reach circle before the local refinement
+
+
+def _solve_on_reach_circle(problem: StepQpProblem, box_step: np.ndarray) -> np.ndarray:
+    """Minimiser of (27a) over the box and the disc |xi1 - u_d| <= com_reach.
+
+    ``box_step`` (the box optimum) lies outside the disc, so by convexity (P_u > 0)
+    the reach is active at the optimum: it is the best point of the circle's arcs
+    inside the box, found on a fine grid of angles and refined by golden-section
+    search. If no point of the circle is inside the box (the CoM is beyond the reach
+    of every allowed step), the box optimum is kept.
+    """
+    assert problem.reach_center is not None
+    lo, hi = problem.box()
+    center, radius = problem.reach_center, problem.reach
+
+    def point(angle: float) -> np.ndarray:
+        return center + radius * np.array([math.cos(angle), math.sin(angle)])
+
+    def inside(u: np.ndarray) -> bool:
+        return bool(np.all(u >= lo - 1e-12) and np.all(u <= hi + 1e-12))
+
+    spacing = 2.0 * math.pi / REACH_SAMPLES
+    angles = spacing * np.arange(REACH_SAMPLES)
+    points = center + radius * np.column_stack([np.cos(angles), np.sin(angles)])
+    ok = np.all((points >= lo - 1e-12) & (points <= hi + 1e-12), axis=1)
+    if not np.any(ok):
+        return box_step
+    diff = problem.target - points
+    values = np.einsum("ij,jk,ik->i", diff, problem.lyapunov_matrix, diff)
+    values[~ok] = np.inf
+    best = int(np.argmin(values))
+    best_angle, best_value = float(angles[best]), float(values[best])
+    a, b = best_angle - spacing, best_angle + spacing
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    for _ in range(40):
+        c, d = b - ratio * (b - a), a + ratio * (b - a)
+        fc = problem.objective(point(c)) if inside(point(c)) else math.inf
+        fd = problem.objective(point(d)) if inside(point(d)) else math.inf
+        if fc <= fd:
+            b = d
+        else:
+            a = c
+    refined = point(0.5 * (a + b))
+    if inside(refined) and problem.objective(refined) <= best_value:
+        return refined
+    return point(best_angle)

@@ -11,6 +11,7 @@ from app.capturability import (
     CaptureModel,
     capture_box,
     capture_distance,
+    first_step_time,
     impulse_bound,
     max_dcm_shift,
     nominal_dcm,
@@ -119,3 +120,31 @@ def test_bad_model_is_a_parameter_error() -> None:
         CaptureModel(3.5, 60.0, (0.1, -0.1), (0.2, 0.1), (-0.4, -0.6), (0.6, 0.6), 0.19, 0.3)
     with pytest.raises(ParameterError):
         capture_box(MODEL, 1, -0.1)
+
+
+def test_first_step_not_before_the_push_ends():
+    """t_1 = max(T_min - s~, Delta): the swing foot ready and the push over."""
+    t_min = MODEL.min_step_time
+    assert first_step_time(t_min, 0.0, 0.1) == pytest.approx(t_min)
+    assert first_step_time(t_min, t_min - 0.1, 0.1) == pytest.approx(0.1)
+    assert first_step_time(t_min, 0.4, 0.1) == pytest.approx(0.1)
+    assert first_step_time(t_min, 0.4, 0.0) == 0.0
+    # Phase 0.5 (s~ = 0.4 s > T_min): the bound is the box with the first step at the
+    # push end, from the nominal DCM, not at the push start.
+    since, delta, angle = 0.4, 0.1, 0.0
+    lo, hi = capture_box(MODEL, -1, delta)
+    shift = max_dcm_shift(nominal_dcm(CONFIG, -1, since), np.array([1.0, 0.0]), lo, hi)
+    expected = shift * MODEL.mass * MODEL.omega / push_discount(MODEL.omega, delta)
+    bound = impulse_bound(CONFIG, angle, -1, since, delta)
+    assert bound == pytest.approx(expected, rel=1e-12)
+    lo0, hi0 = capture_box(MODEL, -1, 0.0)
+    clairvoyant = max_dcm_shift(nominal_dcm(CONFIG, -1, since), np.array([1.0, 0.0]), lo0, hi0)
+    assert bound < 0.8 * clairvoyant * MODEL.mass * MODEL.omega / push_discount(MODEL.omega, delta)
+    # Where the foot is not ready before the push ends, nothing changes.
+    for since in (0.0, 0.1, 0.2):
+        first = max(0.0, t_min - since)
+        lo, hi = capture_box(MODEL, -1, first)
+        shift = max_dcm_shift(nominal_dcm(CONFIG, -1, since), np.array([1.0, 0.0]), lo, hi)
+        assert impulse_bound(CONFIG, 0.0, -1, since, 0.1) == pytest.approx(
+            shift * MODEL.mass * MODEL.omega / push_discount(MODEL.omega, 0.1), rel=1e-12
+        )

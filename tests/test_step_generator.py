@@ -1,5 +1,7 @@
 """The reactive step generator in closed loop with the LIPM: the paper's claims."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -162,3 +164,82 @@ def test_predicted_step_time_and_location_match_the_step_taken():
             config.model, com, velocity, out.zmp, out.angular_momentum_rate, np.zeros(2), dt
         )
     assert checked > 20
+
+
+def _walk_with_push(config, push_start, force, duration, until):
+    """Drive the generator on the exact LIPM with a constant push; returns its outputs."""
+    initial = walking_start(config)
+    generator = ReactiveStepGenerator(config)
+    generator.reset(initial.stance, initial.swing)
+    com, velocity = initial.com_position, initial.com_velocity
+    dt, outputs, estimates = 0.001, [], []
+    for k in range(int(until / dt)):
+        t = k * dt
+        out = generator.update(MeasuredState(t, com, velocity), dt)
+        outputs.append(out)
+        estimates.append(generator.push_estimate.copy())
+        pushed = push_start - 1e-9 <= t < push_start + duration - 1e-9
+        f = np.asarray(force) if pushed else np.zeros(2)
+        com, velocity = integrate_lipm(
+            config.model, com, velocity, out.zmp, out.angular_momentum_rate, f, dt
+        )
+    return outputs, np.array(estimates)
+
+
+def test_push_estimate_is_exact_on_the_lipm():
+    """f c_z / (m g) from two measured DCMs and the commanded CMP, one tick late."""
+    config = PlannerConfig()
+    force = np.array([900.0, 400.0])
+    outputs, estimates = _walk_with_push(config, 2.7, force, 0.1, 3.2)
+    times = np.array([o.time for o in outputs])
+    expected = force * config.model.com_height / (config.model.mass * config.model.gravity)
+    during = (times > 2.7 + 0.0015) & (times < 2.8 - 1e-6)
+    np.testing.assert_allclose(estimates[during], np.tile(expected, (during.sum(), 1)), atol=1e-6)
+    quiet = (times > 0.01) & ((times < 2.7) | (times > 2.8 + 0.0015))
+    assert np.abs(estimates[quiet]).max() < 1e-6
+
+
+@pytest.mark.parametrize("hold", [0.15, 0.0])
+def test_first_step_waits_for_the_end_of_the_push(hold):
+    """Phase 0.5 (s~ = 0.4 s > T_DSP + T_SP): with the push hold the adjusted step
+    comes when the push ends and lands far; with hold 0 (the paper's D_T) it comes
+    ~10 ms into the push with a small step from the still-small DCM error."""
+    config = PlannerConfig(rsg=replace(PlannerConfig().rsg, push_hold_time=hold))
+    outputs, _ = _walk_with_push(config, 2.7, np.array([1000.0, 0.0]), 0.1, 3.0)
+    first = next(o.step for o in outputs if o.step is not None and o.time >= 2.7)
+    assert first.timing_adjusted and first.location_adjusted
+    step_x = first.position[0] - outputs[2699].stance.position[0]
+    if hold > 0.0:
+        assert 2.8 <= first.time <= 2.803
+        assert step_x > 0.5
+    else:
+        assert first.time < 2.73
+        assert step_x < 0.15
+
+
+def test_push_hold_is_bounded_by_its_time():
+    """A push that lasts longer than push_hold_time does not keep the step back."""
+    config = PlannerConfig()
+    outputs, _ = _walk_with_push(config, 2.7, np.array([300.0, 0.0]), 1.0, 3.2)
+    first = next(o.step for o in outputs if o.step is not None and o.time >= 2.7)
+    assert first.time <= 2.7 + config.rsg.push_hold_time + 0.003
+
+
+def test_paper_rules_give_the_papers_jump_set_on_fig6():
+    """--paper-rules: no push hold, no leg reach; paper-fig6 is recovered with the
+    adjusted step while push 1 still acts (V_u reaches gamma_v), the default steps at
+    its end."""
+    from app.lipm_backend import LipmBackend
+    from app.runner import run_closed_loop
+    from app.setup import build_backend
+
+    _, config, _ = build_backend("lipm", "g1", "rsg", paper=True)
+    assert config.rsg.push_hold_time == 0.0 and config.constraints.com_reach == np.inf
+    paper = run_closed_loop(LipmBackend(config.model), config, FIG6, qp_solver="exact")
+    default = run_lipm("rsg", FIG6, qp_solver="exact")
+    push = FIG6.pushes[0]
+    for result, inside in ((paper, True), (default, False)):
+        assert result.recovered, result.fall
+        steps = adjusted_between(result, push.time, FIG6.pushes[1].time)
+        assert len(steps) >= 1
+        assert (steps[0].event["t"] < push.time + push.duration) == inside

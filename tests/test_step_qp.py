@@ -1,6 +1,7 @@
 """The step QP (27): constraints, optimality against brute force, fallback."""
 
 import itertools
+import math
 
 import numpy as np
 import pytest
@@ -35,7 +36,7 @@ def brute_force(problem, n=401):
     best, best_value = None, np.inf
     for x, y in itertools.product(xs, ys):
         u = np.array([x, y])
-        if problem.max_violation(u) <= 1e-12:
+        if problem.max_violation(u) <= 1e-12 and problem.reach_violation(u) <= 1e-12:
             value = problem.objective(u)
             if value < best_value:
                 best, best_value = u, value
@@ -54,6 +55,7 @@ def test_solution_meets_constraints_and_matches_brute_force(seed, sigma, anisotr
     if not solution.feasible:
         pytest.skip(f"infeasible draw: {case}")
     assert problem.max_violation(solution.step) < 1e-6, case  # (27b)-(27d)
+    assert problem.reach_violation(solution.step) < 1e-6, case  # leg reach
     _, grid_value = brute_force(problem, n=201)
     grid_step = (problem.upper - problem.lower) / 200
     slack = (
@@ -64,8 +66,10 @@ def test_solution_meets_constraints_and_matches_brute_force(seed, sigma, anisotr
     )
     assert solution.lyapunov_after <= grid_value + 1e-9, case
     assert solution.lyapunov_after >= grid_value - slack, case
-    exact = solve_box_exact(problem)
+    exact = solve_step_qp(problem, "exact").step
     np.testing.assert_allclose(solution.step, exact, atol=1e-5, err_msg=case)
+    if problem.reach_violation(solve_box_exact(problem)) <= 0.0:
+        np.testing.assert_allclose(exact, solve_box_exact(problem), atol=1e-12, err_msg=case)
 
 
 def test_feet_never_cross_in_the_solution():
@@ -132,3 +136,23 @@ def test_proxqp_matches_the_exact_minimiser_on_many_problems():
         np.testing.assert_allclose(proxqp.step, exact.step, atol=1e-6, err_msg=f"{index=}")
         compared += 1
     assert compared == 1000
+
+
+def test_leg_reach_keeps_the_com_within_reach_of_the_new_foot():
+    """A large diagonal DCM error asks for a step near the box corner (0.6, 0.6); with
+    the leg reach (default 0.58 m) the step leaves the CoM within it, on the reach
+    circle, and is the best such step; with com_reach = inf it is (27) as printed."""
+    xi1, reference = np.array([0.1, 0.05]), np.array([0.05, -0.1])
+    error = np.array([0.6, 0.75])
+    problem = build_step_qp(P_U, error, xi1, reference, -1, CONSTRAINTS, PARAMS)
+    box_only = solve_box_exact(problem)
+    assert np.linalg.norm(xi1 - box_only) > CONSTRAINTS.com_reach + 0.05
+    for solver in ("exact", "proxqp"):
+        step = solve_step_qp(problem, solver).step
+        assert np.linalg.norm(xi1 - step) == pytest.approx(CONSTRAINTS.com_reach, abs=1e-9)
+        assert problem.max_violation(step) < 1e-9
+    _, grid_value = brute_force(problem, n=401)
+    assert solve_step_qp(problem, "exact").lyapunov_after <= grid_value + 1e-9
+    off = Constraints(com_reach=math.inf)
+    paper = build_step_qp(P_U, error, xi1, reference, -1, off, PARAMS)
+    np.testing.assert_allclose(solve_step_qp(paper, "exact").step, box_only, atol=1e-12)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -122,14 +123,17 @@ def test_interrupted_sweep_resumes_to_the_same_envelope(tmp_path: Path, monkeypa
         run_sweep(SweepSpec(**{**TINY.__dict__, "tolerance": 1.0}), tmp_path / "cut", 1)
 
 
-LIPM_SWEEP = SweepSpec(directions=8, phases=(0.0,), tolerance=0.5)
+LIPM_SWEEP = SweepSpec(directions=8, phases=(0.0, 0.5), tolerance=0.5)
 
 
 @pytest.fixture(scope="module")
 def lipm_envelope(tmp_path_factory: pytest.TempPathFactory) -> dict:
-    """The CI sweep: 8 directions, all LIPM controllers, phase 0 of cycle 3."""
+    """The CI sweep: 8 directions, all LIPM controllers, phases 0 and 0.5 of cycle 3
+    (at 0.5 the swing foot is ready at the push: the push hold and the first step at the
+    push end of the bound matter there)."""
     out = tmp_path_factory.mktemp("sweep")
-    records = run_sweep(LIPM_SWEEP, out, workers=2, progress=False)
+    workers = int(os.environ.get("RSG_TEST_WORKERS", "2"))
+    records = run_sweep(LIPM_SWEEP, out, workers=workers, progress=False)
     envelope = build_envelope(LIPM_SWEEP, records)
     paths = write_envelope(out, envelope)
     paths.append(plot_envelope(envelope, out / "envelope.png"))
@@ -137,19 +141,29 @@ def lipm_envelope(tmp_path_factory: pytest.TempPathFactory) -> dict:
     assert json.loads((out / "envelope.json").read_text())["controllers"].keys() == {
         "rsg", "fixed-timing", "no-step"
     }  # fmt: skip
-    assert len((out / "envelope.csv").read_text().splitlines()) == 1 + 3 * 8
+    assert len((out / "envelope.csv").read_text().splitlines()) == 1 + 3 * 8 * 2
     return envelope
 
 
-def test_rsg_reaches_70_percent_of_the_bound_in_every_direction(lipm_envelope: dict) -> None:
-    rows = lipm_envelope["controllers"]["rsg"]["phases"]["0"]
+@pytest.mark.parametrize("phase", ["0", "0.5"])
+def test_rsg_reaches_70_percent_of_the_bound_in_every_direction(
+    lipm_envelope: dict, phase: str
+) -> None:
+    rows = lipm_envelope["controllers"]["rsg"]["phases"][phase]
     assert len(rows) == 8
     for row in rows:
         assert row["ratio"] >= 0.7, row
         assert row["impulse"] <= row["bound"] + LIPM_SWEEP.tolerance, row
 
 
-def test_rsg_beats_the_comparison_controllers(lipm_envelope: dict) -> None:
+@pytest.mark.parametrize("phase", ["0", "0.5"])
+def test_rsg_beats_the_comparison_controllers(lipm_envelope: dict, phase: str) -> None:
+    def mean(controller: str) -> float:
+        rows = lipm_envelope["controllers"][controller]["phases"][phase]
+        return float(np.mean([row["ratio"] for row in rows]))
+
+    assert mean("rsg") > mean("fixed-timing")
+    assert mean("rsg") > mean("no-step")
     ratios = {c: d["mean_ratio"] for c, d in lipm_envelope["controllers"].items()}
     assert ratios["rsg"] > ratios["fixed-timing"]
     assert ratios["rsg"] > ratios["no-step"]
