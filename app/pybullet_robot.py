@@ -2,8 +2,11 @@
 
 One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
 coexist in a process), a flat ground with friction, and the robot loaded from the
-derived URDF with the URDF's inertias. Frames: PyBullet's base pose is the base
-link's *inertial* frame; :meth:`base_pose` converts it to the URDF base frame.
+derived URDF with the URDF's inertias, its fixed-joint links merged into their
+parents (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per
+physics step; a ground contact of the head is reported as one of ``torso_link``).
+Frames: PyBullet's base pose is the base link's *inertial* frame;
+:meth:`base_pose` converts it to the URDF base frame.
 """
 
 from __future__ import annotations
@@ -48,7 +51,8 @@ class SimulatedRobot:
         self.ground = client.loadURDF("plane.urdf", useFixedBase=True)
         client.changeDynamics(self.ground, -1, lateralFriction=description.ground_friction)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
-        self.body = client.loadURDF(str(derived_urdf(description)), [0, 0, 1], flags=flags)
+        urdf = derived_urdf(description, merged=True)
+        self.body = client.loadURDF(str(urdf), [0, 0, 1], flags=flags)
 
         self.joint_indices: list[int] = []
         self.joint_names: list[str] = []
@@ -79,6 +83,12 @@ class SimulatedRobot:
         self._position_gains = [g.position_gain for g in gains]
         self._velocity_gains = [g.velocity_gain for g in gains]
         self._max_forces = [g.max_force for g in gains]
+        self._zero_velocities = [0.0] * len(self.joint_names)
+        # The module functions with the client id: BulletClient's per-call
+        # attribute lookup (a functools.partial each time) costs ~1 us per call.
+        self._client_id = client._client
+        self._set_motors = pybullet.setJointMotorControlArray
+        self._step_simulation = pybullet.stepSimulation
         self.time = 0.0
 
     # ----------------------------------------------------------------- state
@@ -170,31 +180,35 @@ class SimulatedRobot:
     def set_joint_targets(
         self, angles: NDArray[np.float64], velocities: NDArray[np.float64] | None = None
     ) -> None:
-        """Position targets [rad] (and velocity targets [rad/s]) in joint_names order."""
-        target_velocities = np.zeros(len(angles)) if velocities is None else velocities
-        self.client.setJointMotorControlArray(
+        """Position targets [rad] (and velocity targets [rad/s]) in joint_names order.
+
+        Called at every physics step: the arguments go to PyBullet as plain lists
+        and the gains are prepared once (measured 8.4 -> 4.2 us per call).
+        """
+        self._set_motors(
             self.body,
             self.joint_indices,
             pybullet.POSITION_CONTROL,
-            targetPositions=list(angles),
-            targetVelocities=list(target_velocities),
+            targetPositions=angles.tolist(),
+            targetVelocities=self._zero_velocities if velocities is None else velocities.tolist(),
             positionGains=self._position_gains,
             velocityGains=self._velocity_gains,
             forces=self._max_forces,
+            physicsClientId=self._client_id,
         )
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step of PHYSICS_TIME_STEP [s] with a force [N] on the base CoM.
 
         PyBullet clears external forces after each step, so a push lasting several
-        steps must be applied at every step.
+        steps must be applied at every step. ``None`` (or a zero force) applies none.
         """
-        if base_force_world is not None and np.any(base_force_world):
+        if base_force_world is not None and any(base_force_world):
             position, _ = self.client.getBasePositionAndOrientation(self.body)
             self.client.applyExternalForce(
                 self.body, -1, list(base_force_world), position, pybullet.WORLD_FRAME
             )
-        self.client.stepSimulation()
+        self._step_simulation(physicsClientId=self._client_id)
         self.time += PHYSICS_TIME_STEP
 
     def close(self) -> None:

@@ -8,8 +8,11 @@ the foot's collision shapes (G1: four 5 mm spheres, which chatter and bounce in
 PyBullet at every touchdown) are replaced by one thin box spanning the sole
 rectangle, bottom face on the sole plane. :func:`derived_urdf` writes a fixed copy to
 ``$RSG_CACHE_DIR/robots/<name>-<hash>/robot.urdf`` (default cache
-``~/.cache/rsg``). The hash covers the source text and the derivation settings, so
-the same input always gives the same file, and a new input a new folder.
+``~/.cache/rsg``); with ``merged=True``, ``robot-merged.urdf``, the same robot
+with the links of fixed joints merged into their parents
+(:mod:`robots.urdf_merge`), for the physics only (the IK needs the frames). The
+hash covers the source text and the derivation settings, so the same input always
+gives the same file, and a new input a new folder.
 """
 
 from __future__ import annotations
@@ -23,10 +26,11 @@ from pathlib import Path
 
 from planner.exceptions import ParameterError, RsgError
 from robots.description import RobotDescription
+from robots.urdf_merge import merge_fixed_links
 
 DISTRIBUTION = "example-robot-data"
 PACKAGE_PREFIX = "package://"
-DERIVATION_VERSION = "2"  # bump when the derivation below changes
+DERIVATION_VERSION = "3"  # bump when the derivation below (or the merge) changes
 TINY_MASS = 1e-6  # [kg] mass given to links without <inertial>
 TINY_INERTIA = 1e-9  # [kg m^2]
 FOOT_FRAMES = {"left": "left_foot", "right": "right_foot"}
@@ -151,8 +155,13 @@ def derive_urdf_text(description: RobotDescription, source_text: str, share_dir:
     return ET.tostring(root, encoding="unicode") + "\n"
 
 
-def derived_urdf(description: RobotDescription) -> Path:
+def derived_urdf(description: RobotDescription, merged: bool = False) -> Path:
     """Path of the derived URDF of ``description``, created on first use.
+
+    Args:
+        description: The robot.
+        merged: The variant with fixed-joint links merged into their parents
+            (fewer bodies for the physics; no sole/trunk frames).
 
     Raises:
         RobotDataError: The source URDF is not installed.
@@ -171,10 +180,15 @@ def derived_urdf(description: RobotDescription) -> Path:
     key = "\n".join((DERIVATION_VERSION, str(share_dir), *settings, source_text))
     digest = hashlib.sha256(key.encode("utf-8")).hexdigest()[:16]
     folder = cache_root() / "robots" / f"{description.name}-{digest}"
-    target = folder / "robot.urdf"
+    target = folder / ("robot-merged.urdf" if merged else "robot.urdf")
     if target.is_file():
         return target
     text = derive_urdf_text(description, source_text, share_dir)
+    if merged:
+        root = ET.fromstring(text)
+        merge_fixed_links(root)
+        ET.indent(root, space="  ")
+        text = ET.tostring(root, encoding="unicode") + "\n"
     folder.mkdir(parents=True, exist_ok=True)
     # Atomic write: concurrent processes may derive the same file at once.
     with tempfile.NamedTemporaryFile(

@@ -10,6 +10,7 @@ import pytest
 from planner.exceptions import ParameterError
 from robots import available_robots, get_robot
 from robots.urdf_cache import derive_urdf_text, derived_urdf, robots_share_dir
+from robots.urdf_merge import merge_fixed_links
 
 
 @pytest.fixture(autouse=True)
@@ -62,3 +63,76 @@ def test_urdf_mass_matches_description():
     root = ET.parse(derived_urdf(g1)).getroot()
     mass = sum(float(element.get("value")) for element in root.iter("mass"))
     assert mass == pytest.approx(g1.total_mass, abs=0.1)
+
+
+SYNTHETIC_URDF = """<robot name="r">
+  <link name="a"><inertial><origin xyz="0 0 0.1" rpy="0 0 0"/><mass value="2"/>
+    <inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/></inertial></link>
+  <link name="b"><inertial><origin xyz="0.2 0 0" rpy="0 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.02" iyz="0" izz="0.03"/></inertial>
+    <collision><origin xyz="0.1 0 0" rpy="0 0 0"/><geometry><box size="1 1 1"/></geometry>
+    </collision></link>
+  <link name="c"/>
+  <joint name="ab" type="fixed"><origin xyz="0 0.5 0" rpy="0 0 1.5707963267948966"/>
+    <parent link="a"/><child link="b"/></joint>
+  <joint name="bc" type="revolute"><origin xyz="0 0 1" rpy="0 0 0"/><axis xyz="1 0 0"/>
+    <parent link="b"/><child link="c"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>"""
+
+
+def test_merging_a_fixed_link_keeps_mass_com_inertia_and_shapes_in_place():
+    root = ET.fromstring(SYNTHETIC_URDF)
+    merge_fixed_links(root)
+    assert [link.get("name") for link in root.iter("link")] == ["a", "c"]
+    inertial = root.find("link/inertial")
+    assert float(inertial.find("mass").get("value")) == pytest.approx(3.0)
+    # b's CoM: (0, 0.5, 0) + Rz(90 deg) (0.2, 0, 0) = (0, 0.7, 0).
+    com = [float(v) for v in inertial.find("origin").get("xyz").split()]
+    assert com == pytest.approx([0.0, 0.7 / 3, 0.2 / 3])
+    tensor = inertial.find("inertia")
+    # ixx: a 0.1 + 2 (y^2 + z^2) about the new CoM, b 0.02 (rotated) + 1 (...)
+    ixx = 0.1 + 2 * ((0.7 / 3) ** 2 + (0.1 - 0.2 / 3) ** 2)
+    ixx += 0.02 + 1 * ((0.7 - 0.7 / 3) ** 2 + (0.2 / 3) ** 2)
+    assert float(tensor.get("ixx")) == pytest.approx(ixx)
+    box = root.find("link/collision/origin")
+    assert [float(v) for v in box.get("xyz").split()] == pytest.approx([0.0, 0.6, 0.0])
+    joint = root.find("joint")
+    assert joint.find("parent").get("link") == "a"
+    assert [float(v) for v in joint.find("origin").get("xyz").split()] == pytest.approx(
+        [0.0, 0.5, 1.0]
+    )
+    assert [float(v) for v in joint.find("origin").get("rpy").split()] == pytest.approx(
+        [0.0, 0.0, 1.5707963267948966]
+    )
+
+
+def test_merged_g1_has_the_same_joints_mass_and_com_in_pybullet():
+    import numpy as np
+    import pybullet
+    from pybullet_utils.bullet_client import BulletClient
+
+    g1 = get_robot("g1")
+    merged = ET.parse(derived_urdf(g1, merged=True)).getroot()
+    assert not [joint for joint in merged.iter("joint") if joint.get("type") == "fixed"]
+    coms = []
+    for path in (derived_urdf(g1), derived_urdf(g1, merged=True)):
+        client = BulletClient(connection_mode=pybullet.DIRECT)
+        body = client.loadURDF(str(path), flags=pybullet.URDF_USE_INERTIA_FROM_FILE)
+        joints = {}
+        for index in range(client.getNumJoints(body)):
+            info = client.getJointInfo(body, index)
+            if info[2] == pybullet.JOINT_REVOLUTE:
+                joints[info[1].decode()] = index
+        for number, (_, index) in enumerate(sorted(joints.items())):
+            client.resetJointState(body, index, 0.3 * np.sin(number))
+        links = range(client.getNumJoints(body))
+        masses = [client.getDynamicsInfo(body, link)[0] for link in (-1, *links)]
+        positions = [client.getBasePositionAndOrientation(body)[0]]
+        positions += [state[0] for state in client.getLinkStates(body, list(links))]
+        coms.append((sorted(joints), sum(masses), np.array(masses) @ np.array(positions)))
+        client.disconnect()
+    (names, mass, moment), (merged_names, merged_mass, merged_moment) = coms
+    assert merged_names == names and len(names) == 29
+    assert merged_mass == pytest.approx(mass, abs=1e-9)
+    assert merged_moment / merged_mass == pytest.approx(moment / mass, abs=1e-6)
