@@ -118,8 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--paper-rules",
         action="store_true",
-        help="LIPM controllers without the documented extensions (push hold, leg reach in "
-        "the step QP): the paper's jump set and QP (27) as printed",
+        help="the RSG without the documented extensions (push hold, leg reach in the "
+        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
     )
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress bar")

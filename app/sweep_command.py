@@ -75,8 +75,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--paper-rules",
         action="store_true",
-        help="LIPM controllers without the documented extensions (push hold, leg reach in "
-        "the step QP): the paper's jump set and QP (27) as printed",
+        help="the RSG without the documented extensions (push hold, leg reach in the "
+        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
     )
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
     p.add_argument("--backend", choices=("process", "ray"), default="process",

@@ -128,3 +128,41 @@ def test_smooth_swing_starts_without_acceleration_and_lands_on_target():
     assert first["smooth"] < 0.2 * first["cubic"]  # gentle lift-off
     assert np.allclose(smooth.position[:2], target, atol=1e-4)
     assert np.allclose(smooth.velocity, 0.0, atol=1e-3)
+
+
+def test_swing_acceleration_bound_and_descent_funnel():
+    """A foothold that jumps 10 cm late in the swing is reached with bounded
+    acceleration (re-planning horizon >= sqrt(6 d / a)), and the sole does not come
+    down below ``descent_slope`` times the distance still to go."""
+    bounded = SwingFootTrajectory(
+        TIMING, apex_height=0.06, max_acceleration=20.0, descent_slope=0.5
+    )
+    free = SwingFootTrajectory(TIMING, apex_height=0.06)
+    runs = {}
+    for name, trajectory in (("bounded", bounded), ("free", free)):
+        trajectory.start(np.array([0.0, -0.1]))
+        positions = []
+        for k in range(1, round(1.2 / DT) + 1):
+            time = k * DT
+            target = np.array([0.2, -0.1]) if time < 0.55 else np.array([0.2, 0.0])
+            positions.append(trajectory.update(time, target, DT, landing_time=0.6))
+        runs[name] = np.array(positions)
+    late = round(0.55 / DT)
+
+    def peak_acceleration(positions):
+        return np.abs(np.diff(positions[late - 2 :, :2], n=2, axis=0)).max() / DT**2
+
+    assert peak_acceleration(runs["bounded"]) < 0.5 * peak_acceleration(runs["free"])
+    to_go = np.linalg.norm(runs["bounded"][late:, :2] - [0.2, 0.0], axis=1)
+    heights = runs["bounded"][late:, 2]
+    previous = runs["bounded"][late - 1 :, 2][:-1]
+    assert np.all(heights >= np.minimum(previous, 0.5 * to_go) - 1e-9)
+    assert np.linalg.norm(runs["bounded"][-1, :2] - [0.2, 0.0]) < 1e-3
+    assert runs["bounded"][-1, 2] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_swing_bounds_are_validated():
+    with pytest.raises(ParameterError, match="max_acceleration"):
+        SwingFootTrajectory(TIMING, max_acceleration=0.0)
+    with pytest.raises(ParameterError, match="descent_slope"):
+        SwingFootTrajectory(TIMING, descent_slope=-1.0)

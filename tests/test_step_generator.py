@@ -243,3 +243,51 @@ def test_paper_rules_give_the_papers_jump_set_on_fig6():
         steps = adjusted_between(result, push.time, FIG6.pushes[1].time)
         assert len(steps) >= 1
         assert (steps[0].event["t"] < push.time + push.duration) == inside
+
+
+def _reaction_config(reaction_time, **rsg):
+    base = PlannerConfig()
+    return replace(
+        base,
+        rsg=replace(base.rsg, step_reaction_time=reaction_time, push_hold_time=0.0, **rsg),
+    )
+
+
+def test_step_reaction_time_schedules_the_step_and_lands_where_announced():
+    """With a reaction time Delta the timing jump comes Delta after D_T fires (not
+    at once), keeps the time it announced, and lands on the last announced foothold;
+    while it waits the foothold converges (the QP at the predicted touchdown state)."""
+    reaction = 0.1
+    outputs, _ = _walk_with_push(_reaction_config(reaction), 2.7, np.array([0.0, 600.0]), 0.1, 3.2)
+    instant, _ = _walk_with_push(_reaction_config(0.0), 2.7, np.array([0.0, 600.0]), 0.1, 3.2)
+    decided = next(o for o in instant if o.time >= 2.7 and o.step is not None).time
+    index = next(k for k, o in enumerate(outputs) if o.time >= 2.7 and o.step is not None)
+    step = outputs[index].step
+    assert step.timing_adjusted and step.location_adjusted
+    assert step.time == pytest.approx(decided + reaction, abs=2e-3)
+    before = outputs[index - 1]
+    assert before.next_step_time == pytest.approx(step.time, abs=2e-3)
+    np.testing.assert_allclose(before.next_step.position, step.position, atol=1e-12)
+    waiting = [o for o in outputs[index - 90 : index] if o.time > decided + 0.01]
+    assert all(o.next_step_time == pytest.approx(step.time, abs=2e-3) for o in waiting)
+    drift = [np.linalg.norm(o.next_step.position - step.position) for o in waiting]
+    assert drift[-1] < 1e-3 and drift[-1] <= drift[0]
+
+
+def test_step_reaction_time_recovers_what_the_instant_step_recovers():
+    """On the LIPM a 0.1 s reaction time still recovers paper-fig6 scaled x2."""
+    from app.lipm_backend import LipmBackend
+    from app.runner import run_closed_loop
+
+    config = _reaction_config(0.1)
+    result = run_closed_loop(LipmBackend(config.model), config, scaled(FIG6, 2.0))
+    assert result.recovered, result.fall
+    assert any(s.event["timing_adjusted"] for s in result.steps)
+    assert result.violations["crossing"] == 0 and result.violations["step_bounds"] == 0
+
+
+def test_step_reaction_time_is_validated():
+    from planner.exceptions import ParameterError
+
+    with pytest.raises(ParameterError, match="step_reaction_time"):
+        _reaction_config(-0.1)
