@@ -71,15 +71,17 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   940 N): ``landing_clearance`` keeps it 2 mm up until the step. With the three,
   the 20 s walk has no adjusted step (max V_u 0.69 gamma_v) for rsg,
   fixed-timing and no-step.
-* Remaining limitation: an adjusted step is taken at once wherever the swing
-  foot is. In paper-fig6 the RSG steps 0.05 s after the first push (as it does on
-  the LIPM with G1's parameters, which recovers) to a foothold 7.8 cm from the
-  swing sole, which is still 1.8 cm up: the IK's hard stance task drags the foot
-  there within one tick and the robot falls ~2 s later. A "late landing" (old
-  foot kept as support while the foot travels over 0.08-0.15 s, across first and
-  then down, CoM plan clipped to the old sole) was tried and did not help (falls
-  at 4.7-4.9 s instead of 5.9 s): moving the leg 7 cm that fast kicks the CoM
-  (0.1 m/s sideways) and the DCM error reaches 5 cm.
+* Adjusted steps. With the paper's instantaneous jump the RSG stepped 0.05 s
+  after the paper-fig6 push to a foothold 7.8 cm from a swing sole still 1.8 cm up,
+  and the IK's hard stance task dragged the foot there within a tick. G1 now uses
+  the planner's ``step_reaction_time`` (0.2 s): the touchdown is scheduled when D_T
+  fires and the foothold is the QP at the predicted touchdown state; the swing sole
+  follows it with a bounded acceleration (``swing_acceleration``) and does not come
+  down while still far from it (``swing_descent_slope``). Remaining limitation,
+  measured: right after an adjusted step the DCM error jumps by 2-5 cm within
+  50 ms (landing impact, bounce, CoP on a sole edge), which G1's +-2 cm lateral
+  ZMP window cannot absorb, so a second and third adjusted step follow and large
+  lateral pushes still topple it (README, "The full robot").
 """
 
 from __future__ import annotations
@@ -147,8 +149,6 @@ class PyBulletBackend:
         landing_clearance: float = 0.0,
         swing_acceleration: float | None = None,
         swing_descent_slope: float = 0.0,
-        velocity_blend: float | None = None,
-        resync_at_step: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -209,10 +209,6 @@ class PyBulletBackend:
                 acceleration when its target moves [m/s^2] (None: unbounded).
             swing_descent_slope: The swing sole stays at least this many metres
                 up per metre still to go horizontally [-].
-            velocity_blend: Blend of the CoM velocity reference toward the
-                measured velocity [-] (None: ``com_reference_blend``).
-            resync_at_step: At each planner step the CoM reference is reset to
-                the measured CoM state.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -226,10 +222,6 @@ class PyBulletBackend:
             raise ParameterError("com_reference_blend", com_reference_blend, "in [0, 1]")
         self.com_lookahead = com_lookahead
         self.com_reference_blend = com_reference_blend
-        if velocity_blend is not None and not 0.0 <= velocity_blend <= 1.0:
-            raise ParameterError("velocity_blend", velocity_blend, "in [0, 1] or None")
-        self.velocity_blend = com_reference_blend if velocity_blend is None else velocity_blend
-        self.resync_at_step = resync_at_step
         self.com_tracking_gains = com_tracking_gains
         self.interpolate_targets = interpolate_targets
         if not (0.0 <= touchdown_lead <= 0.2 and 0.0 <= touchdown_depth <= 0.02):
@@ -366,9 +358,6 @@ class PyBulletBackend:
             # The planner stepped: the old stance foot lifts off from where it stood.
             self.swing.start(np.asarray(command.previous_stance.position, float))
             self._stance = stance
-            if self.resync_at_step and self._measured is not None:
-                self._com_reference = np.asarray(self._measured.com_position, float).copy()
-                self._com_velocity_reference = np.asarray(self._measured.com_velocity, float).copy()
         com_target = self._advance_com_reference(command)
         time_since_step = command.time_since_step + dt
         # Optional touchdown before the planner's step (``touchdown_lead``); G1
@@ -471,9 +460,7 @@ class PyBulletBackend:
         )
         blend = self.com_reference_blend
         self._com_reference = self._com_reference - blend * position_error
-        self._com_velocity_reference = (
-            self._com_velocity_reference - self.velocity_blend * velocity_error
-        )
+        self._com_velocity_reference = self._com_velocity_reference - blend * velocity_error
         hdot = {
             "full": command.angular_momentum_rate,
             "feedback": command.angular_momentum_rate_feedback,
