@@ -99,7 +99,7 @@ from app.pybullet_com_plan import momentum_aware_pivot
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
-from kinematics.whole_body_ik import WholeBodyIK, sole_pose
+from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
 from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import LipmModel
@@ -289,6 +289,7 @@ class PyBulletBackend:
         self._stance: Foot = "left"
         self._joint_targets = np.zeros(len(self.sim.joint_names))
         self._measured: MeasuredState | None = None
+        self._ik_failure: str | None = None
 
     # ------------------------------------------------------------------ reset
     def reset(self, initial: InitialCondition) -> MeasuredState:
@@ -337,6 +338,7 @@ class PyBulletBackend:
         self._ik_momentum = None
         self._ik_momentum_rate = np.zeros(2)
         self.landing.reset()
+        self._ik_failure = None
         return self._measured
 
     def _ik_reset(
@@ -392,7 +394,15 @@ class PyBulletBackend:
 
         support = "both" if command.double_support else stance
         planned = clock.perf_counter()
-        q = self.ik.solve(com_target, soles["left"], soles["right"], support, dt)[self._ik_to_sim]
+        try:
+            q = self.ik.solve(com_target, soles["left"], soles["right"], support, dt)
+            q = q[self._ik_to_sim]
+        except IkInfeasibleError as error:
+            # Measured only while falling (feet and CoM far apart): hold the last
+            # targets and report the fall instead of ending the run with an error.
+            self._ik_failure = f"whole-body IK infeasible at t = {command.time:.2f} s"
+            self._ik_failure += f" ({error.reason})"
+            q = self._joint_targets
         # Rate of the IK motion's own centroidal angular momentum (low-pass).
         momentum = self.ik.angular_momentum[:2].copy()
         previous_momentum = momentum if self._ik_momentum is None else self._ik_momentum
@@ -512,7 +522,10 @@ class PyBulletBackend:
 
     # ---------------------------------------------------------------- queries
     def fall_status(self) -> FallStatus:
-        """Fallen if the pelvis is low or tilted, or a non-foot body touches the ground."""
+        """Fallen if the pelvis is low or tilted, a non-foot body touches the ground, or
+        the whole-body IK had no solution."""
+        if self._ik_failure is not None:
+            return FallStatus(True, self._ik_failure)
         position, quaternion = self.sim.base_pose()
         if position[2] < self.description.fall_base_height:
             return FallStatus(True, f"pelvis height {position[2]:.3f} m")

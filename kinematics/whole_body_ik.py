@@ -30,11 +30,31 @@ import pinocchio
 import placo
 from numpy.typing import NDArray
 
-from planner.exceptions import ParameterError
+from planner.exceptions import ParameterError, RsgError
 from robots.description import RobotDescription
 from robots.urdf_cache import FOOT_FRAMES, TRUNK_FRAME, derived_urdf
 
 Support = Literal["left", "right", "both"]
+
+
+class IkInfeasibleError(RsgError):
+    """placo's QP found no joint motion meeting the hard tasks (feet, joint limits).
+
+    Attributes:
+        support: The feet whose tasks were hard.
+        com_target: Horizontal CoM target of that solve [m].
+        reason: placo's message.
+    """
+
+    def __init__(self, support: str, com_target: NDArray[np.float64], reason: str) -> None:
+        self.support = support
+        self.com_target = com_target
+        self.reason = reason
+        super().__init__(
+            f"whole-body IK infeasible with support {support!r} and CoM target "
+            f"{np.round(com_target, 3).tolist()} m: {reason}"
+        )
+
 
 FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]
 COM_WEIGHT = 100.0  # CoM task weight [-]
@@ -216,6 +236,10 @@ class WholeBodyIK:
 
         Returns:
             Joint angles [rad] in :attr:`joint_names` order.
+
+        Raises:
+            IkInfeasibleError: placo's QP has no solution (the robot's configuration
+                is left as before the call).
         """
         if support not in ("left", "right", "both"):
             raise ParameterError("support", support, "'left', 'right' or 'both'")
@@ -223,7 +247,12 @@ class WholeBodyIK:
         self.solver.dt = dt
         self._set_targets(com_xy, left_sole, right_sole, angular_momentum)
         previous = np.array(self.robot.state.q, dtype=float)
-        self.solver.solve(True)
+        try:
+            self.solver.solve(True)
+        except RuntimeError as error:  # placo's QP: the hard tasks cannot all hold
+            self.robot.state.q = previous
+            self.robot.update_kinematics()
+            raise IkInfeasibleError(support, np.asarray(com_xy, float), str(error)) from error
         self.robot.update_kinematics()
         velocity = pinocchio.difference(self.robot.model, previous, self.robot.state.q) / dt
         self.angular_momentum = (np.asarray(self.robot.centroidal_map()) @ velocity)[3:6]

@@ -203,3 +203,36 @@ def test_landing_clearance_keeps_the_swing_sole_up_until_the_step(backend):
     assert backend._settle(0.0) == pytest.approx(0.002)
     assert backend._settle(backend.transfer_ramp) == 0.0
     assert not backend.fall_status().fell
+
+
+def test_an_unreachable_stance_foot_is_a_fall_not_a_crash(backend):
+    """Feet 1.5 m apart in double support make placo's QP infeasible: the backend
+    holds its joint targets and reports a fall with the reason."""
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    far = Foothold("left", np.array([1.5, 0.1]))
+    backend.step(command(0.0, np.zeros(2), stance=far, since_step=0.0), np.zeros(2))
+    status = backend.fall_status()
+    assert status.fell and "IK infeasible" in status.reason
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    assert not backend.fall_status().fell
+
+
+def test_ik_infeasibility_is_a_project_error_with_its_data():
+    from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
+    from robots import get_robot
+
+    ik = WholeBodyIK(get_robot("g1"))
+    ik.reset(
+        sole_pose(np.array([0.0, 0.1, 0.0])), sole_pose(np.array([0.0, -0.1, 0.0])), np.zeros(2)
+    )
+    before = ik.joint_angles()
+    with pytest.raises(IkInfeasibleError) as caught:
+        ik.solve(
+            np.zeros(2),
+            sole_pose(np.array([1.0, 0.1, 0.0])),
+            sole_pose(np.array([-1.0, -0.1, 0.0])),
+            "both",
+            0.01,
+        )
+    assert caught.value.support == "both"
+    np.testing.assert_array_equal(ik.joint_angles(), before)
