@@ -32,7 +32,8 @@ def plot_envelope(envelope: dict, path: Path) -> Path:
     columns = min(len(phases), 4)
     rows = math.ceil(len(phases) / columns)
     fig, axes = plt.subplots(
-        rows, columns, subplot_kw={"projection": "polar"}, figsize=(4.2 * columns, 4.4 * rows),
+        rows, columns, subplot_kw={"projection": "polar"},
+        figsize=(max(4.2 * columns, 7.0), 4.4 * rows + 0.6),
         squeeze=False,
     )  # fmt: skip
     spec = envelope["spec"]
@@ -56,13 +57,14 @@ def plot_envelope(envelope: dict, path: Path) -> Path:
     for index in range(len(phases), rows * columns):
         axes[index // columns][index % columns].set_visible(False)
     handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=9)
+    ncol = len(labels) if columns > 1 else min(len(labels), 3)
+    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize=9)
     fig.suptitle(
-        f"Largest recovered impulse [N s] by push direction ({spec['model']}, "
+        f"Largest recovered impulse [N s] by push direction\n({spec['model']}, "
         f"push {spec['duration']} s, cycle {spec['cycle']}; forward up, left to the left)",
         fontsize=10,
     )
-    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
+    fig.tight_layout(rect=(0, 0.1 if columns == 1 else 0.06, 1, 0.93))
     try:
         fig.savefig(path, dpi=110)
     except OSError as exc:

@@ -17,9 +17,10 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   moving foothold with bounded accelerations and stays up while it is still far.
   With the paper's instantaneous step the RSG stepped to footholds 5-8 cm from a
   sole still 2 cm up and fell after every 5 N s push at mid single support in 8
-  directions; with these, 5 of 8 directions recover 5 N s and 3 of 8 recover
-  10 N s (forward, 45 and 90 deg), pushes of 0.1 s at s~ = 0.45 s of the third
-  step, 4 s to settle. 0.15 s recovered none of 8 at 10 N s, 0.25 s two.
+  directions (0.1 s pushes at s~ = 0.45 s of the third step, 4 s to settle); with
+  these, 5 of 8 directions recover 5 N s and 2 of 8 recover 10 N s. Reaction times
+  of 0.15 s and 0.25 s recovered 0 and 2 of 8 at 10 N s. The largest recovered
+  impulse per direction is in the README (``rsg sweep``).
 * ``transfer_lift`` 3 mm: at the planner's step the old foot is raised so the new
   foot carries the weight at once, as the planner's reference model assumes
   (landing without it leaves the CoP on the old foot for ~50 ms: 3-4 cm of DCM
