@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +56,11 @@ def summary_of(result: RunResult, controller: str) -> dict:
             "mu_2": config.rsg.crossing_margin,
             "mu_3": config.rsg.com_margin,
             "swing_preparation_time": config.rsg.swing_preparation_time,
+            "step_reaction_time": config.rsg.step_reaction_time,
+            "push_hold_time": config.rsg.push_hold_time,
+            "com_reach": None
+            if math.isinf(config.constraints.com_reach)
+            else config.constraints.com_reach,
             "zmp_window_min": list(config.constraints.zmp_window_min),
             "zmp_window_max": list(config.constraints.zmp_window_max),
             "angular_momentum_rate_max": config.constraints.angular_momentum_rate_max,
