@@ -47,12 +47,13 @@ QP_AGREEMENT = 1e-4  # [m] proxqp and the exact method "agree" within this
 
 
 def stats(samples: list[float]) -> dict:
-    """Median, 95th percentile [s] and count of ``samples``."""
+    """Median, 95th percentile, mean [s] and count of ``samples``."""
     if not samples:
-        return {"median": None, "p95": None, "count": 0}
+        return {"median": None, "p95": None, "mean": None, "count": 0}
     data = np.asarray(samples)
     return {
         "median": float(np.median(data)),
+        "mean": float(np.mean(data)),
         "p95": float(np.percentile(data, 95)),
         "count": len(samples),
     }
@@ -280,5 +281,25 @@ def bench_command(args: argparse.Namespace) -> int:
         f"objective is {'never' if report['qp_exact_objective_not_worse'] else 'sometimes'} "
         "worse than proxqp's"
     )
+    if not args.no_robot:
+        print(tick_breakdown(report))
     print(f"wrote {path}")
     return 0
+
+
+def tick_breakdown(report: dict) -> str:
+    """One line: the mean time per control tick of each part of the robot loop [ms]."""
+    timers = report["backend_timers_mean_per_tick"]
+    parts = {
+        "physics": timers.get("physics", 0.0),
+        "state estimation": timers.get("estimation", 0.0),
+        "RSG": report["robot_planner_tick"]["mean"] or 0.0,
+        "CoM plan and swing foot": timers.get("planning", 0.0),
+        "IK": timers.get("ik", 0.0),
+    }
+    listed = ", ".join(f"{name} {1e3 * value:.2f} ms" for name, value in parts.items())
+    return (
+        f"mean per {1e3 * report['control_period']:.0f} ms tick on the robot: {listed}; "
+        f"total {1e3 * sum(parts.values()):.2f} ms; real-time factor "
+        f"{report['real_time_factor']:.2f}"
+    )

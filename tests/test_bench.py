@@ -40,3 +40,19 @@ def test_bench_command_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture
     assert report["qp_exact"]["count"] == 50
     assert "planner tick" in capsys.readouterr().out
     assert "| IK solve |" in format_bench(report)
+
+
+def test_tick_breakdown_adds_up_the_parts() -> None:
+    from app.bench import tick_breakdown
+
+    report = {
+        "control_period": 0.01,
+        "real_time_factor": 2.0,
+        "robot_planner_tick": stats([1e-4, 1e-4]),
+        "backend_timers_mean_per_tick": {
+            "physics": 4e-3, "estimation": 1e-4, "planning": 2e-4, "ik": 2e-4,
+        },
+    }  # fmt: skip
+    line = tick_breakdown(report)
+    assert "physics 4.00 ms" in line and "RSG 0.10 ms" in line and "IK 0.20 ms" in line
+    assert "total 4.60 ms" in line and "real-time factor 2.00" in line
