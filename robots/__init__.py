@@ -9,8 +9,9 @@ from __future__ import annotations
 from planner.exceptions import ParameterError
 from robots.description import JointGains, RobotDescription, SoleRectangle
 from robots.g1 import G1
+from robots.talos import TALOS
 
-_REGISTRY: dict[str, RobotDescription] = {G1.name: G1}
+_REGISTRY: dict[str, RobotDescription] = {robot.name: robot for robot in (G1, TALOS)}
 
 __all__ = ["JointGains", "RobotDescription", "SoleRectangle", "available_robots", "get_robot"]
 

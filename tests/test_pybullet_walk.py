@@ -33,15 +33,19 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 
 
 def run_g1(
-    scenario: Scenario, controller: str = "rsg", duration: float | None = None
+    scenario: Scenario,
+    controller: str = "rsg",
+    duration: float | None = None,
+    robot: str = "g1",
 ) -> tuple[RunResult, list[float]]:
-    """Run ``scenario`` on G1; returns the result and each step's landing error [m].
+    """Run ``scenario`` on ``robot`` (G1 by default); returns the result and each
+    step's landing error [m].
 
     The landing error is measured at the end of the step's double support, when
     the new stance foot is down: the distance between the measured sole and the
     planner's step position.
     """
-    backend, config, initial = build_robot_backend("g1", controller)
+    backend, config, initial = build_robot_backend(robot, controller)
     if duration is not None:
         scenario = dataclasses.replace(scenario, duration=duration)
     scaled, _ = scenario.scaled_to(backend.mass)
@@ -78,6 +82,17 @@ def test_g1_walks_20_s_with_the_rsg_and_lands_where_planned():
     assert result.sim_time == pytest.approx(20.0)
     assert len(errors) >= 20
     assert max(errors) < LANDING_TOLERANCE
+    assert result.recovered
+
+
+def test_talos_walks_10_s_with_the_rsg_and_lands_where_planned():
+    """The second robot: only its description (robots/talos.py), no controller change."""
+    result, errors = run_g1(BUILT_IN["walk"], duration=10.0, robot="talos")
+    assert not result.fall.fell, result.fall.reason
+    assert result.sim_time == pytest.approx(10.0)
+    assert len(errors) >= 10
+    assert max(errors) < LANDING_TOLERANCE
+    assert not any(s.event["adjusted"] for s in result.steps)
     assert result.recovered
 
 

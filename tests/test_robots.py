@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import pytest
 
@@ -18,8 +19,9 @@ def _cache_in_tmp(tmp_path, monkeypatch):
     monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path))
 
 
-def test_registry_lists_g1_and_rejects_unknown_names():
-    assert "g1" in available_robots()
+def test_registry_lists_g1_and_talos_and_rejects_unknown_names():
+    assert {"g1", "talos"} <= set(available_robots())
+    assert get_robot("talos").name == "talos"
     assert get_robot("g1").name == "g1"
     with pytest.raises(ParameterError) as error:
         get_robot("no_such_robot")
@@ -136,3 +138,45 @@ def test_merged_g1_has_the_same_joints_mass_and_com_in_pybullet():
     assert merged_names == names and len(names) == 29
     assert merged_mass == pytest.approx(mass, abs=1e-9)
     assert merged_moment / merged_mass == pytest.approx(moment / mass, abs=1e-6)
+
+
+def test_talos_description_validates_and_names_joints_of_its_urdf():
+    talos = get_robot("talos")
+    with pytest.raises(ParameterError):
+        dataclasses.replace(talos, sole_offset=(0.0, 0.0, 0.107))
+    root = ET.parse(derived_urdf(talos)).getroot()
+    joints = {joint.get("name") for joint in root.findall("joint") if joint.get("type") != "fixed"}
+    assert set(talos.standing_posture) <= joints
+    assert set(talos.joint_gains) <= joints
+
+
+def test_talos_derived_urdf_has_sole_frames_under_the_ankles_and_resolved_meshes():
+    talos = get_robot("talos")
+    root = ET.parse(derived_urdf(talos)).getroot()
+    links = {link.get("name"): link for link in root.iter("link")}
+    assert {"left_foot", "right_foot", "trunk"} <= set(links)
+    assert all(link.find("inertial") is not None for link in links.values())
+    joints = {joint.find("child").get("link"): joint for joint in root.findall("joint")}
+    for frame, ankle in (("left_foot", "leg_left_6_link"), ("right_foot", "leg_right_6_link")):
+        assert joints[frame].find("parent").get("link") == ankle
+        assert joints[frame].find("origin").get("xyz") == "0 0 -0.107"
+    assert joints["trunk"].find("parent").get("link") == "torso_2_link"
+    meshes = [mesh.get("filename") for mesh in root.iter("mesh")]
+    assert meshes and not any(name.startswith("package://") for name in meshes)
+    assert all(Path(name).is_file() for name in meshes)
+    mass = sum(float(element.get("value")) for element in root.iter("mass"))
+    assert mass == pytest.approx(talos.total_mass, abs=0.1)
+
+
+def test_talos_mass_in_pybullet_and_placo_equals_the_urdf_mass():
+    from app.pybullet_robot import SimulatedRobot
+    from kinematics.whole_body_ik import WholeBodyIK
+
+    talos = get_robot("talos")
+    robot = SimulatedRobot(talos)
+    try:
+        assert robot.mass == pytest.approx(talos.total_mass, abs=0.01)
+        assert len(robot.joint_names) == 32
+    finally:
+        robot.close()
+    assert WholeBodyIK(talos).robot.total_mass() == pytest.approx(talos.total_mass, abs=0.01)
