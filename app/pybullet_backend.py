@@ -149,6 +149,7 @@ class PyBulletBackend:
         landing_clearance: float = 0.0,
         swing_acceleration: float | None = None,
         swing_descent_slope: float = 0.0,
+        foothold_feedback: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -209,6 +210,9 @@ class PyBulletBackend:
                 acceleration when its target moves [m/s^2] (None: unbounded).
             swing_descent_slope: The swing sole stays at least this many metres
                 up per metre still to go horizontally [-].
+            foothold_feedback: At the end of each double support, measure how far
+                the stance sole stands from the planner's foothold and aim the swing
+                foot that much the other way, so landing errors do not add up.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -259,6 +263,8 @@ class PyBulletBackend:
         self._ik_momentum: NDArray[np.float64] | None = None
         self._ik_momentum_rate = np.zeros(2)
         self.landing = LandingCorrection(landing_correction)
+        self.foothold_feedback = foothold_feedback
+        self._stance_offset = np.zeros(2)  # measured stance sole - o_H [m]
         if not 0.0 <= landing_clearance <= 0.01:
             raise ParameterError("landing_clearance", landing_clearance, "in [0, 0.01] m")
         self.landing_clearance = landing_clearance
@@ -339,6 +345,7 @@ class PyBulletBackend:
         self._ik_momentum_rate = np.zeros(2)
         self.landing.reset()
         self._ik_failure = None
+        self._stance_offset = np.zeros(2)
         return self._measured
 
     def _ik_reset(
@@ -377,6 +384,12 @@ class PyBulletBackend:
         )
         self.landing.observe(command)
         target = self.landing.target(command)
+        if self.foothold_feedback:
+            end = self.timing.double_support
+            if command.time_since_step <= end < time_since_step:
+                sole = self.sim.sole_position(stance)[:2]
+                self._stance_offset = sole - np.asarray(command.stance.position, float)
+            target = target - self._stance_offset
         swing_position = self.swing.update(time_since_step, target, dt, landing)
         swing_position[2] = max(swing_position[2] - self._press_depth(swing_position), -0.01)
         swing_position[2] = max(swing_position[2], self.landing_clearance)

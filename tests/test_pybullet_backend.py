@@ -236,3 +236,22 @@ def test_ik_infeasibility_is_a_project_error_with_its_data():
         )
     assert caught.value.support == "both"
     np.testing.assert_array_equal(ik.joint_angles(), before)
+
+
+def test_foothold_feedback_aims_the_swing_foot_against_the_stance_offset():
+    """The stance sole is measured at the end of the double support; the swing target
+    is shifted by minus its offset from the planner's foothold."""
+    backend = PyBulletBackend("g1", foothold_feedback=True)
+    try:
+        shifted = Foothold("left", LEFT.position + np.array([0.01, 0.0]))  # o_H 1 cm ahead
+        backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+        for tick in range(15):
+            since = tick * backend.control_period
+            backend.step(
+                command(since, LEFT.position, stance=shifted, since_step=since), np.zeros(2)
+            )
+        measured = backend.sim.sole_position("left")[:2]
+        np.testing.assert_allclose(backend._stance_offset, measured - shifted.position, atol=1e-3)
+        assert backend._stance_offset[0] == pytest.approx(-0.01, abs=0.004)
+    finally:
+        backend.close()
