@@ -71,6 +71,12 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   940 N): ``landing_clearance`` keeps it 2 mm up until the step. With the three,
   the 20 s walk has no adjusted step (max V_u 0.69 gamma_v) for rsg,
   fixed-timing and no-step.
+* Foothold drift (``foothold_feedback``). The IK places the swing foot relative
+  to the stance foot it believes is on the planner's foothold; a real stance foot
+  that landed off it shifts the next landing by as much, and the errors add up
+  (G1: ~0.8 mm per step, 2 cm after 30 s, a 60 s walk fell at 31 s). Measuring
+  the stance sole at the end of the double support and aiming the swing foot
+  against that offset: the 60 s walk lasts 46 s.
 * Adjusted steps. With the paper's instantaneous jump the RSG stepped 0.05 s
   after the paper-fig6 push to a foothold 7.8 cm from a swing sole still 1.8 cm up,
   and the IK's hard stance task dragged the foot there within a tick. G1 now uses
