@@ -4,7 +4,7 @@ The walk and paper-fig6 tests state the goal of the full-robot backend. They are
 marked ``xfail(strict=True)`` while the goal is not met, so that they start to
 fail (and the marker must go) as soon as it is. Status, measured with the G1
 defaults of ``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted,
-max V_u 0.47 gamma_v); paper-fig6 still falls at 5.4 s (after the first adjusted
+max V_u 0.47 gamma_v); paper-fig6 still falls at 5.3 s (after the first adjusted
 step the DCM error is back above the lateral ZMP window within 50 ms); see
 ``app/pybullet_backend.py``.
 """
@@ -24,7 +24,7 @@ from planner.types import Push
 pytestmark = pytest.mark.slow
 
 LANDING_TOLERANCE = 0.03  # [m] measured sole vs. the planner's step position
-NOT_YET = "G1 paper-fig6 not achieved yet: falls 1.6 s after the first push"
+NOT_YET = "G1 paper-fig6 not achieved yet: falls 1.5 s after the first push"
 
 
 @pytest.fixture(autouse=True)
