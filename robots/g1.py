@@ -109,6 +109,21 @@ JOINT_GAINS = {
     },
 }
 
+#: PyBullet backend options tuned on G1 (reasons in the module docstring); Talos
+#: walks with them unchanged.
+WALKING_OPTIONS = {
+    "com_reference_blend": 0.05,
+    "com_tracking_gains": (1.0, 0.0),
+    "transfer_lift": 0.003,
+    "momentum_compensation": 1.0,
+    "momentum_filter": 0.05,
+    "cop_margin": 0.0,
+    "landing_correction": 1.0,
+    "landing_clearance": 0.002,
+    "swing_acceleration": 20.0,
+    "swing_descent_slope": 0.5,
+}
+
 G1 = RobotDescription(
     name="g1",
     urdf_source="g1_description/urdf/g1_29dof_rev_1_0.urdf",
@@ -130,17 +145,5 @@ G1 = RobotDescription(
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
-    backend_options={
-        "com_reference_blend": 0.05,
-        "com_tracking_gains": (1.0, 0.0),
-        "transfer_lift": 0.003,
-        "momentum_compensation": 1.0,
-        "momentum_filter": 0.05,
-        "cop_margin": 0.0,
-        "landing_correction": 1.0,
-        "landing_clearance": 0.002,
-        "swing_acceleration": 20.0,
-        "swing_descent_slope": 0.5,
-        "foothold_feedback": True,
-    },
+    backend_options={**WALKING_OPTIONS, "foothold_feedback": True},
 )

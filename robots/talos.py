@@ -40,6 +40,7 @@ final sole gives 11.9 mm after 20 s against 12.2 mm.)
 from __future__ import annotations
 
 from robots.description import JointGains, RobotDescription, SoleRectangle
+from robots.g1 import WALKING_OPTIONS
 
 # Half-sitting posture of talos.srdf (legs and arms; torso and head at 0). Leg joints
 # 1-6: hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle roll; the right arm's
@@ -100,16 +101,5 @@ TALOS = RobotDescription(
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
-    backend_options={
-        "com_reference_blend": 0.05,
-        "com_tracking_gains": (1.0, 0.0),
-        "transfer_lift": 0.003,
-        "momentum_compensation": 1.0,
-        "momentum_filter": 0.05,
-        "cop_margin": 0.0,
-        "landing_correction": 1.0,
-        "landing_clearance": 0.002,
-        "swing_acceleration": 20.0,
-        "swing_descent_slope": 0.5,
-    },
+    backend_options=dict(WALKING_OPTIONS),  # G1's, unchanged
 )
