@@ -186,8 +186,8 @@ def test_ray_backend_gives_the_same_envelope(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_full_robot_sweep_compares_the_controllers_forward(tmp_path: Path) -> None:
     """A small G1 sweep with the baseline beside the RSG: forward pushes at mid single
-    support (coarse bisection). Measured: rsg 6.7 N s, no-step 3.4 N s (finer, in the
-    README: 9.2 and 5.9 N s); placo-wpg takes part and the envelope is written."""
+    support (coarse bisection; the README has the 1 N s sweep: rsg 10.9, no-step 6.7
+    N s); placo-wpg takes part and the envelope is written."""
     spec = SweepSpec(
         model="pybullet", controllers=("rsg", "no-step", "placo-wpg"), directions=1,
         phases=(0.5625,), tolerance=4.0, settle=4.0, criterion="no-fall",
