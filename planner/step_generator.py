@@ -157,11 +157,14 @@ class ReactiveStepGenerator:
         """e_u (18) [m]."""
         return dcm(self.omega, xi) - self.reference.dcm()
 
+    @property
+    def earliest_step(self) -> float:
+        """T_DSP + T_SP, the earliest s~ at which the swing foot can land [s]."""
+        return self.config.gait.double_support_duration + self.config.rsg.swing_preparation_time
+
     def _ready_to_step(self, lead: float = 0.0) -> bool:
         """s~ + ``lead`` >= T_DSP + T_SP."""
-        gait, rsg = self.config.gait, self.config.rsg
-        ready = gait.double_support_duration + rsg.swing_preparation_time
-        return self.time_since_step + lead >= ready - 1e-9
+        return self.time_since_step + lead >= self.earliest_step - 1e-9
 
     def _estimate_push(self, dcm_world: np.ndarray) -> None:
         """Update the push estimate from the DCM measured now and at the last tick.
@@ -198,9 +201,8 @@ class ReactiveStepGenerator:
     def _schedule(self, xi1: np.ndarray, level: float) -> bool:
         """Decide a timing jump (D_T) if none is scheduled; True when it is due now."""
         if self.scheduled_step is None and self._timing_jump(xi1, level):
-            gait, rsg = self.config.gait, self.config.rsg
-            ready = gait.double_support_duration + rsg.swing_preparation_time
-            self.scheduled_step = max(self.time_since_step + rsg.step_reaction_time, ready)
+            reaction = self.config.rsg.step_reaction_time
+            self.scheduled_step = max(self.time_since_step + reaction, self.earliest_step)
         due = self.scheduled_step
         return due is not None and self.time_since_step >= due - 1e-9
 
@@ -249,8 +251,7 @@ class ReactiveStepGenerator:
 
     def _nominal_wait(self) -> float:
         """Time [s] until the gated D_S: the reference's jump, not before s~ = T_DSP + T_SP."""
-        gait, rsg = self.config.gait, self.config.rsg
-        ready = gait.double_support_duration + rsg.swing_preparation_time - self.time_since_step
+        ready = self.earliest_step - self.time_since_step
         wait = max(self.reference.time_to_nominal_jump(), ready, 0.0)
         return wait if math.isfinite(wait) else max(ready, 0.0)
 
@@ -262,7 +263,8 @@ class ReactiveStepGenerator:
     ) -> np.ndarray:
         """Where the next step would land [m], re-planned at each tick.
 
-        With V_u >= gamma_v it is the QP (27) at the current state; otherwise the
+        With a timing jump scheduled it is the QP (27) at the state predicted at its
+        touchdown; with V_u >= gamma_v the QP at the current state; otherwise the
         nominal step 2 xi1* at the reference's next (gated) nominal jump.
 
         Args:
@@ -278,8 +280,7 @@ class ReactiveStepGenerator:
             step, _, _ = self._step_location(
                 predicted[:2], predicted_error, level, "exact", reference_xi1
             )
-            self.announced_step = self.stance + step
-            return self.announced_step.copy()
+            return self.stance + step
         if self.config.adjusts_location and level >= self.design.threshold:
             step, _, _ = self._step_location(xi[:2], error, level, "exact")
             return self.stance + step
@@ -292,17 +293,16 @@ class ReactiveStepGenerator:
     ) -> float:
         """When the next step is expected [s], re-planned at each tick.
 
-        While V_u >= gamma_v and timing adjustment is on, D_T,1 fires as soon as the
-        swing foot can land (s~ = T_DSP + T_SP) or now if that is past; otherwise
-        the step comes when the reference reaches D_S.
+        A scheduled timing jump comes at its scheduled time. While V_u >= gamma_v
+        and timing adjustment is on, D_T,1 fires as soon as the swing foot can land
+        (s~ = T_DSP + T_SP, and ``step_reaction_time`` from now) or now if that is
+        past; otherwise the step comes when the reference reaches D_S.
         """
         if self.scheduled_step is not None:
             return time + max(self.scheduled_step - self.time_since_step, 0.0)
         if self.config.adjusts_timing and level >= self.design.threshold:
-            gait, rsg = self.config.gait, self.config.rsg
-            earliest = gait.double_support_duration + rsg.swing_preparation_time
-            wait = max(earliest - self.time_since_step, rsg.step_reaction_time, 0.0)
-            return time + wait
+            reaction = self.config.rsg.step_reaction_time
+            return time + max(self.earliest_step - self.time_since_step, reaction, 0.0)
         return time + (self._nominal_wait() if nominal_wait is None else nominal_wait)
 
     # ------------------------------------------------------------ one tick
@@ -346,7 +346,6 @@ class ReactiveStepGenerator:
             self.window_start = window_now
             self.time_since_step = 0.0
             self.scheduled_step = None
-            self.announced_step = None
             self.reference.jump()
             step_event = StepEvent(
                 time=measured.time,
@@ -389,6 +388,9 @@ class ReactiveStepGenerator:
             self.model.mass * self.model.gravity
         )
         self._last_period = period
+        # The swing foot is sent to the announced foothold: a scheduled step lands there.
+        scheduled = self.scheduled_step is not None
+        self.announced_step = output.next_step.position.copy() if scheduled else None
         self._flow(error, window_offset, period)
         return output
 
