@@ -77,6 +77,16 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   (G1: ~0.8 mm per step, 2 cm after 30 s, a 60 s walk fell at 31 s). Measuring
   the stance sole at the end of the double support and aiming the swing foot
   against that offset: the 60 s walk lasts 46 s.
+* Measured CoP (``cop_feedback``, ``cop_admittance``). Joint position control
+  realises the CoM plan's CoP only approximately: laterally it was biased (0.71 cm
+  rms, and the 60 s walk still fell at 46 s), and after a push it went bang-bang
+  between heel and toe while the plan asked for the middle, which kept the robot in
+  a cycle of adjusted steps. Two loops on the CoP measured from the contact forces
+  (:meth:`SimulatedRobot.foot_pressure`): the stance ankle's targets move it onto the
+  plan's (:mod:`app.pybullet_ankle`; G1: 180 s walk, no adjusted step), and the CoM
+  plan gives way to the difference (CoM admittance,
+  :func:`app.pybullet_com_plan.cop_admittance_zmp`; G1: one adjusted step after
+  8 N s forward, then nominal walking).
 * Adjusted steps. With the paper's instantaneous jump the RSG stepped 0.05 s
   after the paper-fig6 push to a foothold 7.8 cm from a swing sole still 1.8 cm up,
   and the IK's hard stance task dragged the foot there within a tick. G1 now uses
@@ -101,9 +111,10 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from app.backend import FallStatus, InitialCondition
-from app.pybullet_com_plan import momentum_aware_pivot
+from app.pybullet_ankle import MIN_LOAD_FRACTION, AnkleCopFeedback
+from app.pybullet_com_plan import cop_admittance_zmp, momentum_aware_pivot
 from app.pybullet_landing import LandingCorrection
-from app.pybullet_robot import PHYSICS_TIME_STEP, SimulatedRobot
+from app.pybullet_robot import GRAVITY, PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
@@ -156,6 +167,8 @@ class PyBulletBackend:
         swing_acceleration: float | None = None,
         swing_descent_slope: float = 0.0,
         foothold_feedback: bool = False,
+        cop_feedback: float | tuple[float, float] = 0.0,
+        cop_admittance: float = 0.0,
     ) -> None:
         """Load the robot.
 
@@ -219,6 +232,12 @@ class PyBulletBackend:
             foothold_feedback: At the end of each double support, measure how far
                 the stance sole stands from the planner's foothold and aim the swing
                 foot that much the other way, so landing errors do not add up.
+            cop_feedback: Gains (forward, lateral) [rad / (m s)] of
+                :class:`app.pybullet_ankle.AnkleCopFeedback`: in single support the
+                stance ankle's targets move the measured CoP onto the CoM plan's.
+            cop_admittance: Gain A [-] of the CoM admittance
+                (:func:`app.pybullet_com_plan.cop_admittance_zmp`): the CoM plan is
+                integrated with its CoP moved by A (planned - measured CoP).
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -271,6 +290,12 @@ class PyBulletBackend:
         self.landing = LandingCorrection(landing_correction)
         self.foothold_feedback = foothold_feedback
         self._stance_offset = np.zeros(2)  # measured stance sole - o_H [m]
+        self.ankle = AnkleCopFeedback(cop_feedback)
+        if not 0.0 <= cop_admittance <= 2.0:
+            raise ParameterError("cop_admittance", cop_admittance, "in [0, 2]")
+        self.cop_admittance = cop_admittance
+        self._plan_cop = np.zeros(2)  # CoP of the CoM plan over the last tick [m]
+        self._pressure: dict[str, tuple[NDArray[np.float64], float]] = {}
         if not 0.0 <= landing_clearance <= 0.01:
             raise ParameterError("landing_clearance", landing_clearance, "in [0, 0.01] m")
         self.landing_clearance = landing_clearance
@@ -280,6 +305,11 @@ class PyBulletBackend:
         self.sim = SimulatedRobot(self.description)
         self.ik = WholeBodyIK(self.description, use_angular_momentum=use_angular_momentum)
         self._ik_to_sim = [self.ik.joint_names.index(name) for name in self.sim.joint_names]
+        self._ankle_joints = {foot: self._ankle_joint_names(foot) for foot in ("left", "right")}
+        self._ankle_sim_index = {
+            foot: [self.sim.joint_names.index(name) for name in names]
+            for foot, names in self._ankle_joints.items()
+        }
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
         self._lipm = LipmModel(mass=self.mass, com_height=self.com_height)
@@ -352,6 +382,8 @@ class PyBulletBackend:
         self.landing.reset()
         self._ik_failure = None
         self._stance_offset = np.zeros(2)
+        self.ankle.reset()
+        self._plan_cop = np.asarray(initial.com_position, float).copy()
         return self._measured
 
     def _ik_reset(
@@ -430,6 +462,8 @@ class PyBulletBackend:
         self._ik_momentum_rate += min(dt / self.momentum_filter, 1.0) * (
             rate - self._ik_momentum_rate
         )
+        if self.ankle.enabled:
+            q = self._with_ankle_offsets(command, q)
         solved = clock.perf_counter()
         previous = self._joint_targets
         velocity = (q - previous) / dt
@@ -498,6 +532,9 @@ class PyBulletBackend:
         zmp = np.asarray(command.zmp, float)
         if self.momentum_compensation > 0.0:
             zmp, hdot = self._momentum_aware_pivot(command, zmp, hdot)
+        planned_before, self._plan_cop = self._plan_cop, zmp
+        if self.cop_admittance > 0.0:
+            zmp = cop_admittance_zmp(zmp, planned_before, self._measured_cop(), self.cop_admittance)
         self._com_reference, self._com_velocity_reference = integrate_lipm(
             self._lipm,
             self._com_reference,
@@ -535,7 +572,47 @@ class PyBulletBackend:
             ramped_double_support=self.plan_angular_momentum != "full",
         )
 
+    def _ankle_joint_names(self, foot: str) -> list[str]:
+        """The two joints above ``foot``'s ankle link, nearest first (roll, pitch on G1)."""
+        model = self.ik.robot.model
+        first = model.frames[model.getFrameId(self.description.ankle_link(foot))].parentJoint
+        return [model.names[first], model.names[model.parents[first]]]
+
+    def _with_ankle_offsets(
+        self, command: PlannerOutput, q: NDArray[np.float64]
+    ) -> NDArray[np.float64]:
+        """Joint targets ``q`` (simulator order) plus the ankle CoP feedback's offsets."""
+        stance = command.stance.foot
+        robot = self.ik.robot
+        jacobian = robot.frame_jacobian(self.description.ankle_link(stance), "world")
+        axes = [
+            jacobian[3:6, robot.get_joint_v_offset(name)] for name in self._ankle_joints[stance]
+        ]
+        offsets = self.ankle.update(
+            self.control_period,
+            stance,
+            not command.double_support,
+            self._plan_cop,
+            self._pressure.get(stance),
+            axes,
+            self.mass * GRAVITY,
+        )
+        q = q.copy()
+        for foot, offset in offsets.items():
+            q[self._ankle_sim_index[foot]] += offset
+        return q
+
+    def _measured_cop(self) -> NDArray[np.float64] | None:
+        """CoP of both feet [m] at the end of the last tick (None: hardly loaded)."""
+        total = sum(force for _, force in self._pressure.values())
+        if total < MIN_LOAD_FRACTION * self.mass * GRAVITY:
+            return None
+        moment = np.sum([cop * force for cop, force in self._pressure.values()], axis=0)
+        return np.asarray(moment / total, dtype=float)
+
     def _measure(self) -> MeasuredState:
+        if self.ankle.enabled or self.cop_admittance > 0.0:
+            self._pressure = self.sim.foot_pressure()
         com, com_velocity = self.sim.com_state()
         return MeasuredState(self.sim.time, com[:2].copy(), com_velocity[:2].copy())
 
@@ -556,6 +633,15 @@ class PyBulletBackend:
             names = sorted(self.sim.link_name(link) for link in others)
             return FallStatus(True, f"ground contact of {', '.join(names)}")
         return FallStatus(False)
+
+    @property
+    def planned_cop(self) -> NDArray[np.float64]:
+        """CoP [m] the CoM plan assumed over the last tick, shape (2,)."""
+        return self._plan_cop
+
+    def foot_pressure(self) -> dict[str, tuple[NDArray[np.float64], float]]:
+        """Foot -> (measured CoP [m], normal force [N]) of the feet on the ground."""
+        return self.sim.foot_pressure()
 
     def feet_in_contact(self) -> set[str]:
         """Feet touching the ground."""

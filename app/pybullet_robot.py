@@ -164,6 +164,25 @@ class SimulatedRobot:
         contacts = self.ground_contacts()
         return {foot for foot, link in self.foot_links.items() if link in contacts}
 
+    def foot_pressure(self) -> dict[str, tuple[NDArray[np.float64], float]]:
+        """Foot -> (CoP on the ground [m], shape (2,), normal force [N]) of its contacts.
+
+        Feet without contact are absent.
+        """
+        sums: dict[int, list[float]] = {}
+        for point in self.client.getContactPoints(bodyA=self.body, bodyB=self.ground):
+            entry = sums.setdefault(point[3], [0.0, 0.0, 0.0])
+            force = point[9]
+            entry[0] += force * point[6][0]
+            entry[1] += force * point[6][1]
+            entry[2] += force
+        result = {}
+        for foot, link in self.foot_links.items():
+            total = sums.get(link, [0.0, 0.0, 0.0])
+            if total[2] > 1e-6:
+                result[foot] = (np.array(total[:2]) / total[2], total[2])
+        return result
+
     def link_name(self, link: int) -> str:
         """URDF name of PyBullet link index ``link`` (-1: the base)."""
         return self._link_names.get(link, str(link))

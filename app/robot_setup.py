@@ -61,8 +61,9 @@ def planner_config_for(
     )
 
 
-def build_robot_backend(robot: str, controller: str):  # noqa: ANN201
-    """PyBullet backend, planner configuration and walking start for ``robot``.
+def build_robot_backend(robot: str | RobotDescription, controller: str):  # noqa: ANN201
+    """PyBullet backend, planner configuration and walking start for ``robot``
+    (a registry name or a description).
 
     Raises:
         ParameterError: Unknown robot.
@@ -71,7 +72,7 @@ def build_robot_backend(robot: str, controller: str):  # noqa: ANN201
 
     from .pybullet_backend import PyBulletBackend
 
-    description = get_robot(robot)
+    description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
     backend = PyBulletBackend(description, **description.backend_options)
     config = planner_config_for(description, backend.mass, controller)
     timing = SwingTiming(

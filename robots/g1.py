@@ -25,9 +25,23 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   measured, and the swing foot is aimed that much the other way. Without it the
   real feet landed a further ~0.8 mm ahead of the planner's footholds at every
   step (2 cm after 30 s), the mean DCM error followed (0.5 -> 5 mm in 25 s) and a
-  60 s walk fell at 31 s; with it the walk goes on to 46 s, the 20 s walk's V_u
-  peak drops from 0.71 to 0.47 gamma_v, and 10 N s at mid single support is
-  survived in 3 of 8 directions instead of 2. (Talos walks better without it.)
+  60 s walk fell at 31 s; with it (before the CoP loops below) the walk went on to
+  46 s, the 20 s walk's V_u peak dropped from 0.71 to 0.47 gamma_v, and 10 N s at
+  mid single support was survived in 3 of 8 directions instead of 2. (Talos walks
+  better without it.)
+* ``cop_feedback`` (0, 2) rad/(m s) (``app/pybullet_ankle.py``): in single
+  support the stance ankle's targets move the measured CoP onto the CoM plan's,
+  laterally only. The lateral CoP error drops from 0.71 to 0.40 cm rms, and the
+  walk stops drifting: 180 s with no adjusted step (it fell at 46 s before). A
+  forward gain raised the forward error (2: 1.27 -> 1.83 cm rms); a lateral gain of
+  5 raised V_u at landings to 1.2 gamma_v. (Talos: V_u 0.52 -> 1.05 gamma_v with it,
+  so Talos leaves it off.)
+* ``cop_admittance`` 0.3 (``app/pybullet_com_plan.py``): the CoM plan is integrated
+  with its CoP moved by 0.3 (planned - measured CoP). Without it, after 8 N s forward
+  at mid single support the CoP went bang-bang between heel and toe and every later
+  step was adjusted; with it the walk is nominal again after one adjusted step.
+  Over 32 pushes (4-10 N s, 8 directions) it survives 19 and recovers 10 (16 and 6
+  without; gains 0.2 and 0.5: 16 and 9).
 * ``transfer_lift`` 3 mm: at the planner's step the old foot is raised so the new
   foot carries the weight at once, as the planner's reference model assumes
   (landing without it leaves the CoP on the old foot for ~50 ms: 3-4 cm of DCM
@@ -145,5 +159,10 @@ G1 = RobotDescription(
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
-    backend_options={**WALKING_OPTIONS, "foothold_feedback": True},
+    backend_options={
+        **WALKING_OPTIONS,
+        "foothold_feedback": True,
+        "cop_feedback": (0.0, 2.0),
+        "cop_admittance": 0.3,
+    },
 )

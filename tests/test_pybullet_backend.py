@@ -9,7 +9,7 @@ import pytest
 
 from app.backend import InitialCondition
 from app.pybullet_backend import PyBulletBackend
-from app.pybullet_com_plan import clip_to_hull
+from app.pybullet_com_plan import ADMITTANCE_LIMIT, clip_to_hull, cop_admittance_zmp
 from planner.exceptions import ParameterError
 from planner.types import Foothold, PlannerOutput, StepEvent
 
@@ -115,6 +115,9 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
         {"landing_clearance": -0.001},
         {"landing_clearance": 0.02},
         {"landing_correction": 2.0},
+        {"cop_feedback": -1.0},
+        {"cop_admittance": -0.1},
+        {"cop_admittance": 3.0},
     ],
 )
 def test_walking_options_are_validated(options):
@@ -139,6 +142,33 @@ def test_old_foot_is_lifted_after_the_step_and_the_cop_plan_stays_on_the_sole(ba
         assert RIGHT.position[1] - 0.025 - 1e-9 <= zmp[1] <= RIGHT.position[1] + 0.025
     assert lifts[0] < lifts[-1] == pytest.approx(0.003, abs=5e-4)
     assert not backend.fall_status().fell
+
+
+def test_the_measured_cop_carries_the_weight_under_the_com(backend):
+    """Standing still: the ground reaction of both feet is m g, its CoP under the CoM."""
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    state = stand(backend, 1.0)
+    pressure = backend.foot_pressure()
+    assert set(pressure) == {"left", "right"}
+    total = sum(force for _, force in pressure.values())
+    cop = sum(point * force for point, force in pressure.values()) / total
+    assert total == pytest.approx(backend.mass * 9.81, rel=0.03)
+    assert np.linalg.norm(cop - state.com_position) < 0.01
+
+
+def test_cop_admittance_moves_the_plan_to_bring_the_measured_cop_to_the_planned_one():
+    """c'' = omega^2 (c - p): a measured CoP behind the planned one (the joints
+    accelerate the CoM forward more than planned) makes the plan accelerate less."""
+    omega2, com = 9.81 / 0.66, np.array([0.02, 0.0])
+    planned = np.array([0.03, 0.0])
+    for measured, sign in (([0.0, 0.0], -1.0), ([0.06, 0.01], 1.0)):
+        zmp = cop_admittance_zmp(planned, planned, np.array(measured), gain=0.3)
+        change = omega2 * (com - zmp) - omega2 * (com - planned)
+        assert np.sign(change[0]) == sign
+        assert change == pytest.approx(-0.3 * omega2 * (planned - np.array(measured)))
+    assert np.array_equal(cop_admittance_zmp(planned, planned, None, 0.3), planned)
+    far = cop_admittance_zmp(planned, planned, np.array([1.0, -1.0]), gain=0.3)
+    assert np.allclose(np.abs(far - planned), ADMITTANCE_LIMIT)
 
 
 def test_clip_to_hull_keeps_inside_points_and_projects_outside_ones():

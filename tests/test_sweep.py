@@ -186,18 +186,22 @@ def test_ray_backend_gives_the_same_envelope(tmp_path: Path) -> None:
 @pytest.mark.slow
 def test_full_robot_sweep_compares_the_controllers_forward(tmp_path: Path) -> None:
     """A small G1 sweep with the baseline beside the RSG: forward pushes at mid single
-    support (coarse bisection; the README has the 1 N s sweep: rsg 10.9, no-step 6.7
-    N s); placo-wpg takes part and the envelope is written."""
+    support (coarse bisection; the README has the 1 N s sweep: rsg 12.6, no-step
+    10.1 N s; at this tolerance both reach the same bracket); placo-wpg takes part and
+    the envelope is written. That the RSG survives pushes no-step does not is
+    checked in tests/test_pybullet_walk.py."""
     spec = SweepSpec(
         model="pybullet", controllers=("rsg", "no-step", "placo-wpg"), directions=1,
         phases=(0.5625,), tolerance=4.0, settle=4.0, criterion="no-fall",
     )  # fmt: skip
     records = run_sweep(spec, tmp_path, workers=2, progress=False)
-    impulse = {record["controller"]: record["impulse"] for record in records}
-    assert set(impulse) == {"rsg", "no-step", "placo-wpg"}
+    impulse: dict[str, float] = {}
     for record in records:
         assert record["bound"] > 0.0 and 0.0 <= record["impulse"] <= 1.1 * record["bound"]
-    assert impulse["rsg"] > impulse["no-step"] > 0.0
+        impulse[record["controller"]] = impulse.get(record["controller"], 0.0) + record["impulse"]
+    assert set(impulse) == {"rsg", "no-step", "placo-wpg"}
+    assert len(records) == 3
+    assert impulse["rsg"] >= impulse["no-step"] > 0.0
     envelope = build_envelope(spec, records)
     write_envelope(tmp_path, envelope)
     plot_envelope(envelope, tmp_path / "envelope.png")
