@@ -1,4 +1,4 @@
-"""The ``rsg`` command line: ``rsg run``, ``rsg sweep``, ``rsg bench`` and plug-in commands.
+"""The ``rsg`` command line: ``rsg run``, ``rsg sweep``, ``rsg grid``, ``rsg bench``, plug-ins.
 
 Packages that sit above ``app`` (the browser demo in ``web``) add their commands
 through the entry-point group ``rsg.commands`` (see pyproject.toml): each entry is a
@@ -126,9 +126,11 @@ def build_parser() -> argparse.ArgumentParser:
     for command in plugin_commands().values():
         command.add_parser(sub)
     from .bench import add_bench_parser
+    from .grid_command import add_grid_parser
     from .sweep_command import add_sweep_parser
 
     add_sweep_parser(sub)
+    add_grid_parser(sub)
     add_bench_parser(sub)
     return parser
 
@@ -149,6 +151,10 @@ def main(argv: list[str] | None = None) -> int:
             from .sweep_command import sweep_command
 
             return sweep_command(args)
+        if args.command == "grid":
+            from .grid_command import grid_command
+
+            return grid_command(args)
         if args.command == "bench":
             from .bench import bench_command
 

@@ -18,8 +18,8 @@ it, the CoP under the stance foot went bang-bang between heel and toe (the plan
 asked for 0.51-0.59 m, the foot pressed at 0.484 or 0.654 m), the forward DCM
 error swung +-4 cm every step, and all 16 steps after the push were adjusted (one
 every 0.6 s) until the end; with A = 0.3, one adjusted step and the walk is
-nominal again. On 32 pushes (4, 6, 8 and 10 N s in 8 directions, 0.1 s at mid
-single support) the robot survived 19 and fully recovered 10, against 16 and 6
+nominal again. On 32 pushes (``rsg grid``: 4, 6, 8 and 10 N s in 8 directions,
+0.1 s at mid single support) the robot survived 19 and fully recovered 10, against 16 and 6
 without (A = 0.2 and 0.5: 16 and 9). A 180 s walk still has no adjusted step.
 """
 

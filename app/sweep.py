@@ -30,6 +30,7 @@ from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
@@ -43,6 +44,21 @@ from .scenarios import Scenario
 from .sweep_trial import SettledTrial, push_timing
 
 PLACO_WPG = "placo-wpg"
+
+
+class GridLike(Protocol):
+    """What :func:`build_controller` reads of a specification."""
+
+    @property
+    def model(self) -> str: ...
+    @property
+    def robot(self) -> str: ...
+    @property
+    def paper_rules(self) -> bool: ...
+    @property
+    def fall_dcm_error(self) -> float: ...
+
+
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
 JOBS_FILE = "jobs.jsonl"
 SPEC_FILE = "sweep_spec.json"
@@ -146,12 +162,13 @@ class Job:
 
 
 def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
-    """Backend, configuration and initial condition of ``controller`` (see :func:`_build_job`)."""
-    return _build_job(spec, controller)[:3]
+    """Backend, configuration and initial condition (see :func:`build_controller`)."""
+    return build_controller(spec, controller)[:3]
 
 
-def _build_job(spec: SweepSpec, controller: str):  # noqa: ANN202
-    """Backend, configuration, initial condition and planner factory (None: the RSG's)."""
+def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
+    """Backend, configuration, initial condition and planner factory (None: the RSG's)
+    of ``controller`` on ``spec``'s model and robot."""
     if controller == PLACO_WPG:
         from .placo_wpg import build_placo_wpg_backend
 
@@ -159,7 +176,7 @@ def _build_job(spec: SweepSpec, controller: str):  # noqa: ANN202
     return (*_build_rsg(spec, controller), None)
 
 
-def _build_rsg(spec: SweepSpec, controller: str):  # noqa: ANN202
+def _build_rsg(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
     from .setup import build_backend
 
     backend, config, initial = build_backend(spec.model, spec.robot, controller, spec.paper_rules)
@@ -175,7 +192,7 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
     from .runner import run_closed_loop
 
     started = time.perf_counter()
-    backend, config, initial, planner = _build_job(spec, job.controller)
+    backend, config, initial, planner = build_controller(spec, job.controller)
     runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
     options = {} if planner is None else {"planner": planner}
     early = spec.model == "lipm" and spec.criterion == "recovered"

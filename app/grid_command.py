@@ -1,0 +1,106 @@
+"""``rsg grid``: command-line options and the command (see :mod:`app.push_grid`)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+from planner.exceptions import ParameterError
+
+from .push_grid import GridSpec, format_grid, run_grid, write_grid
+from .sweep import SWEEP_CONTROLLERS
+
+EPILOG = """\
+examples:
+  rsg grid --out results/grid-g1          # G1: rsg, fixed-timing, no-step; 4,6,8,10 N s; 8 dirs
+  rsg grid --phases 0.25 --controllers rsg --out results/grid-g1-early
+  rsg grid --model lipm --impulses 20,40,60 --directions 16 --out results/grid-lipm
+
+outputs in --out:
+  grid.json   the specification, counts per controller, phase and impulse, every run
+  grid.csv    one row per run: controller, phase, direction, impulse, outcome, ...
+  grid.png    outcome per impulse and direction, one panel per controller and phase
+"""
+
+
+def _numbers(name: str):  # noqa: ANN202
+    def parse(text: str) -> tuple[float, ...]:
+        try:
+            values = tuple(float(part) for part in text.split(",") if part.strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name}={text!r}: numbers like 4,6,8") from None
+        if not values:
+            raise argparse.ArgumentTypeError(f"{name}={text!r}: at least one number")
+        return values
+
+    return parse
+
+
+def add_grid_parser(sub: argparse._SubParsersAction) -> None:
+    """Add ``rsg grid`` to the subcommands."""
+    p = sub.add_parser(
+        "grid",
+        help="push grid: every controller against the same fixed pushes, one run each",
+        description="Run each controller once per push impulse, direction and phase and "
+        "report recovered / survived / fell: a comparison that, unlike the sweep's "
+        "bisection, does not assume recovery is monotonic in the impulse.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--model", choices=("lipm", "pybullet"), default="pybullet")
+    p.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    p.add_argument(
+        "--controllers",
+        default="rsg,fixed-timing,no-step",
+        help=f"comma-separated, of {', '.join(SWEEP_CONTROLLERS)} (default: rsg,fixed-timing,"
+        "no-step)",
+    )
+    p.add_argument("--impulses", type=_numbers("--impulses"), default=(4.0, 6.0, 8.0, 10.0),
+                   help="push impulses [N s] (default 4,6,8,10)")  # fmt: skip
+    p.add_argument("--directions", type=int, default=8, help="push directions (default 8)")
+    p.add_argument("--phases", type=_numbers("--phases"), default=(0.5625,),
+                   help="push phases, fractions of the walking cycle (default 0.5625: mid "
+                   "single support)")  # fmt: skip
+    p.add_argument("--duration", type=float, default=0.1, help="push duration [s] (0.1)")
+    p.add_argument("--settle", type=float, default=4.0, help="time after the push [s] (4)")
+    p.add_argument("--paper-rules", action="store_true",
+                   help="the RSG without the documented extensions")  # fmt: skip
+    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
+    p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    p.add_argument("--no-plots", action="store_true", help="skip grid.png")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def grid_command(args: argparse.Namespace) -> int:
+    """Run ``rsg grid``; returns 0."""
+    controllers = tuple(c.strip() for c in args.controllers.split(",") if c.strip())
+    if "placo-wpg" in controllers and args.model == "lipm":
+        raise ParameterError("--controllers", "placo-wpg", "controllers without placo-wpg on "
+                             "--model lipm (placo-wpg drives the full robot's IK)")  # fmt: skip
+    spec = GridSpec(
+        model=args.model,
+        robot=args.robot,
+        controllers=controllers,
+        impulses=args.impulses,
+        directions=args.directions,
+        phases=args.phases,
+        duration=args.duration,
+        settle=args.settle,
+        paper_rules=args.paper_rules,
+    )
+    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    started = time.perf_counter()
+    records = run_grid(spec, workers, progress=not args.quiet)
+    wall_time = time.perf_counter() - started
+    paths = write_grid(args.out, spec, records, wall_time)
+    if not args.no_plots:
+        from .grid_plot import plot_grid
+
+        paths.append(plot_grid(spec, records, args.out / "grid.png"))
+    for path in paths:
+        print(f"wrote {path}")
+    print(format_grid(spec, records))
+    print(f"grid: {len(records)} runs, {wall_time:.0f} s wall time")
+    return 0

@@ -1,0 +1,270 @@
+"""Push grid: every controller against the same fixed pushes, one run each.
+
+The sweep (:mod:`app.sweep`) bisects the largest recovered impulse per direction,
+which assumes recovery is monotonic in the impulse. On the full robot it is not
+(G1 at 45 deg, mid single support: 4 and 8 N s survived, 6 and 10 N s fell), so a
+bisection can stop at any of several thresholds. The grid runs each
+(controller, phase, direction, impulse) once and reports each outcome:
+
+* ``recovered``: no fall, V_u below gamma_v at the end and the last two steps
+  nominal (:attr:`app.runner.RunResult.recovered`);
+* ``survived``: no fall within ``settle`` after the push start;
+* ``fell``.
+
+Counts over the grid compare controllers without the monotonicity assumption.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Iterable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from planner.exceptions import ParameterError, RsgError
+from planner.types import Push
+
+from .scenarios import Scenario
+from .sweep import SWEEP_CONTROLLERS, JobProgress, build_controller
+from .sweep_trial import push_timing
+
+OUTCOMES = ("recovered", "survived", "fell")
+
+
+@dataclass(frozen=True)
+class GridSpec:
+    """What the grid runs.
+
+    Attributes:
+        model: ``lipm`` or ``pybullet``.
+        robot: Robot for ``pybullet``.
+        controllers: Controllers to compare.
+        impulses: Push impulses [N s].
+        directions: Number of push directions, evenly spaced from 0 (forward).
+        phases: Push phases p in [0, 1) of the walking cycle (as the sweep's).
+        duration: Push duration [s].
+        cycle: Walking cycle (>= 1) in which the push starts.
+        settle: Simulated time after the push start [s].
+        paper_rules: The RSG without the documented extensions.
+        fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
+    """
+
+    model: str = "pybullet"
+    robot: str = "g1"
+    controllers: tuple[str, ...] = ("rsg", "fixed-timing", "no-step")
+    impulses: tuple[float, ...] = (4.0, 6.0, 8.0, 10.0)
+    directions: int = 8
+    phases: tuple[float, ...] = (0.5625,)
+    duration: float = 0.1
+    cycle: int = 3
+    settle: float = 4.0
+    paper_rules: bool = False
+    fall_dcm_error: float = 2.0
+
+    def __post_init__(self) -> None:
+        if self.model not in ("lipm", "pybullet"):
+            raise ParameterError("model", self.model, "lipm or pybullet")
+        bad = [c for c in self.controllers if c not in SWEEP_CONTROLLERS]
+        if bad or not self.controllers or len(set(self.controllers)) != len(self.controllers):
+            raise ParameterError(
+                "controllers", ",".join(self.controllers), f"distinct of {SWEEP_CONTROLLERS}"
+            )
+        if "placo-wpg" in self.controllers and self.model != "pybullet":
+            raise ParameterError("controllers", "placo-wpg", "placo-wpg only with pybullet")
+        if not self.impulses or not all(
+            math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses
+        ):
+            raise ParameterError("impulses", self.impulses, "impulses in (0, 1000] N s")
+        if not (isinstance(self.directions, int) and 1 <= self.directions <= 360):
+            raise ParameterError("directions", self.directions, "an integer in [1, 360]")
+        if not self.phases or not all(0.0 <= p < 1.0 for p in self.phases):
+            raise ParameterError("phases", self.phases, "fractions in [0, 1)")
+        if not (math.isfinite(self.duration) and 1e-3 <= self.duration <= 1.0):
+            raise ParameterError("duration", self.duration, "a number in [0.001, 1] s")
+        if not (math.isfinite(self.settle) and 1.0 <= self.settle <= 60.0):
+            raise ParameterError("settle", self.settle, "a number in [1, 60] s")
+        if not (isinstance(self.cycle, int) and 1 <= self.cycle <= 20):
+            raise ParameterError("cycle", self.cycle, "an integer in [1, 20]")
+
+    def directions_deg(self) -> list[float]:
+        """Push directions [deg]."""
+        return [360.0 * i / self.directions for i in range(self.directions)]
+
+
+@dataclass(frozen=True)
+class GridJob:
+    """One run of the grid."""
+
+    controller: str
+    phase: float
+    direction_deg: float
+    impulse: float
+
+
+def all_grid_jobs(spec: GridSpec) -> list[GridJob]:
+    """Every run, controller by controller."""
+    return [
+        GridJob(controller, phase, direction, impulse)
+        for controller in spec.controllers
+        for phase in spec.phases
+        for impulse in spec.impulses
+        for direction in spec.directions_deg()
+    ]
+
+
+def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
+    """One push; returns its JSON-ready record."""
+    from .runner import run_closed_loop
+
+    started = time.perf_counter()
+    backend, config, initial, planner = build_controller(spec, job.controller)
+    runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
+    options = {} if planner is None else {"planner": planner}
+    try:
+        t_push, sigma, _ = push_timing(config, spec.cycle, job.phase)
+        angle = math.radians(job.direction_deg)
+        direction = np.array([math.cos(angle), math.sin(angle)])
+        push = Push(t_push, job.impulse * direction, spec.duration)
+        scenario = Scenario("grid", t_push + spec.settle, (push,))
+        result = runner(backend, config, scenario, initial, qp_solver="exact", **options)
+    finally:
+        backend.close()
+    if result.recovered:
+        outcome = "recovered"
+    elif not result.fall.fell:
+        outcome = "survived"
+    else:
+        outcome = "fell"
+    return {
+        **asdict(job),
+        "outcome": outcome,
+        "push_time": t_push,
+        "stance": "left" if sigma > 0 else "right",
+        "end_time": result.sim_time,
+        "fall_reason": result.fall.reason,
+        "adjusted_steps": sum(bool(s.event["adjusted"]) for s in result.steps),
+        "wall_time": time.perf_counter() - started,
+    }
+
+
+def _run_grid_job_args(args: tuple[GridSpec, GridJob]) -> dict:
+    return run_grid_job(*args)
+
+
+def run_grid(spec: GridSpec, workers: int = 1, progress: bool = True) -> list[dict]:
+    """Run every job of ``spec``; returns the records in :func:`all_grid_jobs` order.
+
+    Raises:
+        ParameterError: Bad ``workers``.
+    """
+    if not (isinstance(workers, int) and 1 <= workers <= 1024):
+        raise ParameterError("--workers", workers, "an integer in [1, 1024]")
+    jobs = all_grid_jobs(spec)
+    bar = JobProgress(len(jobs), 0, progress)
+    records: dict[GridJob, dict] = {}
+    for job, record in _execute(spec, jobs, workers):
+        records[job] = record
+        bar.advance()
+    return [records[job] for job in jobs]
+
+
+def _execute(spec: GridSpec, jobs: list[GridJob], workers: int) -> Iterable[tuple[GridJob, dict]]:
+    if workers == 1:
+        for job in jobs:
+            yield job, run_grid_job(spec, job)
+        return
+    with ProcessPoolExecutor(max_workers=workers) as pool:
+        futures = {pool.submit(_run_grid_job_args, (spec, job)): job for job in jobs}
+        try:
+            for future in as_completed(futures):
+                yield futures[future], future.result()
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+
+
+def summarize(spec: GridSpec, records: list[dict]) -> dict:
+    """Per controller and phase: counts of each outcome, in total and per impulse."""
+    summary: dict = {}
+    for controller in spec.controllers:
+        for phase in spec.phases:
+            rows = [r for r in records if r["controller"] == controller and r["phase"] == phase]
+            per_impulse = {}
+            for impulse in spec.impulses:
+                chosen = [r for r in rows if r["impulse"] == impulse]
+                per_impulse[f"{impulse:g}"] = _counts(chosen)
+            summary.setdefault(controller, {})[f"{phase:g}"] = {
+                "total": _counts(rows),
+                "per_impulse": per_impulse,
+            }
+    return summary
+
+
+def _counts(rows: list[dict]) -> dict[str, int]:
+    counts = {outcome: sum(r["outcome"] == outcome for r in rows) for outcome in OUTCOMES}
+    counts["not_fallen"] = counts["recovered"] + counts["survived"]
+    counts["runs"] = len(rows)
+    return counts
+
+
+def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float) -> list[Path]:
+    """``grid.json`` (spec, summary, records) and ``grid.csv`` (one row per run)."""
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        document = {
+            "spec": asdict(spec),
+            "outcomes": {
+                "recovered": "no fall, V_u < gamma_v at the end, last two steps nominal",
+                "survived": "no fall within settle after the push start",
+                "fell": "fell",
+            },
+            "units": {"impulse": "N s", "direction_deg": "deg", "phase": "-"},
+            "summary": summarize(spec, records),
+            "records": records,
+            "wall_time": wall_time,
+        }
+        json_path = out / "grid.json"
+        json_path.write_text(json.dumps(document, indent=2) + "\n")
+        csv_path = out / "grid.csv"
+        columns = ["controller", "phase", "direction_deg", "impulse", "outcome", "push_time",
+                   "stance", "end_time", "adjusted_steps", "fall_reason"]  # fmt: skip
+        lines = [",".join(columns)]
+        lines += [",".join(str(r[c]).replace(",", ";") for c in columns) for r in records]
+        csv_path.write_text("\n".join(lines) + "\n")
+    except OSError as exc:
+        raise RsgError(f"cannot write the grid to {out}: {exc}") from exc
+    return [json_path, csv_path]
+
+
+def format_grid(spec: GridSpec, records: list[dict]) -> str:
+    """Per controller and phase: not fallen (recovered) per impulse, and a row of symbols
+    per impulse over the directions (o recovered, s survived, x fell)."""
+    symbol = {"recovered": "o", "survived": "s", "fell": "x"}
+    directions = " ".join(f"{d:g}" for d in spec.directions_deg())
+    lines = [f"outcome per direction ({directions} deg): o recovered, s survived, x fell"]
+    summary = summarize(spec, records)
+    for controller in spec.controllers:
+        for phase in spec.phases:
+            part = summary[controller][f"{phase:g}"]
+            total = part["total"]
+            cells = []
+            for impulse in spec.impulses:
+                rows = [
+                    r for r in records
+                    if r["controller"] == controller and r["phase"] == phase
+                    and r["impulse"] == impulse
+                ]  # fmt: skip
+                counts = part["per_impulse"][f"{impulse:g}"]
+                marks = "".join(symbol[r["outcome"]] for r in rows)
+                cells.append(f"{impulse:g} N s {counts['not_fallen']}/{counts['runs']} [{marks}]")
+            lines.append(
+                f"{controller:<13} phase {phase:g}: not fallen {total['not_fallen']}/"
+                f"{total['runs']}, recovered {total['recovered']}; " + "; ".join(cells)
+            )
+    return "\n".join(lines)
