@@ -30,7 +30,7 @@ from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
 from .scenarios import Scenario
-from .sweep import SWEEP_CONTROLLERS, JobProgress, build_controller
+from .sweep import JobProgress, build_controller, check_pushes
 from .sweep_trial import push_timing
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -67,23 +67,11 @@ class GridSpec:
     fall_dcm_error: float = 2.0
 
     def __post_init__(self) -> None:
-        if self.model not in ("lipm", "pybullet"):
-            raise ParameterError("model", self.model, "lipm or pybullet")
-        bad = [c for c in self.controllers if c not in SWEEP_CONTROLLERS]
-        if bad or not self.controllers or len(set(self.controllers)) != len(self.controllers):
-            raise ParameterError(
-                "controllers", ",".join(self.controllers), f"distinct of {SWEEP_CONTROLLERS}"
-            )
-        if "placo-wpg" in self.controllers and self.model != "pybullet":
-            raise ParameterError("controllers", "placo-wpg", "placo-wpg only with pybullet")
+        check_pushes(self.model, self.controllers, self.directions, self.phases)
         if not self.impulses or not all(
             math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses
         ):
             raise ParameterError("impulses", self.impulses, "impulses in (0, 1000] N s")
-        if not (isinstance(self.directions, int) and 1 <= self.directions <= 360):
-            raise ParameterError("directions", self.directions, "an integer in [1, 360]")
-        if not self.phases or not all(0.0 <= p < 1.0 for p in self.phases):
-            raise ParameterError("phases", self.phases, "fractions in [0, 1)")
         if not (math.isfinite(self.duration) and 1e-3 <= self.duration <= 1.0):
             raise ParameterError("duration", self.duration, "a number in [0.001, 1] s")
         if not (math.isfinite(self.settle) and 1.0 <= self.settle <= 60.0):

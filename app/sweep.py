@@ -67,6 +67,34 @@ RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules")  # fmt: skip
 
 
+def check_pushes(
+    model: str, controllers: tuple[str, ...], directions: int, phases: tuple[float, ...]
+) -> None:
+    """Validate what a sweep and a push grid share.
+
+    Raises:
+        ParameterError: naming the field, the value and what is allowed.
+    """
+    if model not in ("lipm", "pybullet"):
+        raise ParameterError("model", model, "lipm or pybullet")
+    bad = [c for c in controllers if c not in SWEEP_CONTROLLERS]
+    if bad or not controllers or len(set(controllers)) != len(controllers):
+        raise ParameterError(
+            "controllers", ",".join(controllers), f"distinct of {SWEEP_CONTROLLERS}"
+        )
+    if PLACO_WPG in controllers and model != "pybullet":
+        raise ParameterError(
+            "controllers",
+            PLACO_WPG,
+            "placo-wpg only with --model pybullet (it drives the full robot's IK; "
+            "on the LIPM it has no meaning)",
+        )
+    if not (isinstance(directions, int) and 1 <= directions <= 360):
+        raise ParameterError("directions", directions, "an integer in [1, 360]")
+    if not phases or not all(0.0 <= p < 1.0 for p in phases):
+        raise ParameterError("phases", phases, "fractions in [0, 1)")
+
+
 @dataclass(frozen=True)
 class SweepSpec:
     """What to sweep.
@@ -108,24 +136,7 @@ class SweepSpec:
     paper_rules: bool = False
 
     def __post_init__(self) -> None:
-        if self.model not in ("lipm", "pybullet"):
-            raise ParameterError("model", self.model, "lipm or pybullet")
-        bad = [c for c in self.controllers if c not in SWEEP_CONTROLLERS]
-        if bad or not self.controllers or len(set(self.controllers)) != len(self.controllers):
-            raise ParameterError(
-                "controllers", ",".join(self.controllers), f"distinct of {SWEEP_CONTROLLERS}"
-            )
-        if PLACO_WPG in self.controllers and self.model != "pybullet":
-            raise ParameterError(
-                "controllers",
-                PLACO_WPG,
-                "placo-wpg only with --model pybullet (it drives the full robot's IK; "
-                "on the LIPM it has no meaning)",
-            )
-        if not (isinstance(self.directions, int) and 1 <= self.directions <= 360):
-            raise ParameterError("directions", self.directions, "an integer in [1, 360]")
-        if not self.phases or not all(0.0 <= p < 1.0 for p in self.phases):
-            raise ParameterError("phases", self.phases, "fractions in [0, 1)")
+        check_pushes(self.model, self.controllers, self.directions, self.phases)
         checks = {
             "duration": (self.duration, 1e-3, 1.0),
             "settle": (self.settle, 1.0, 60.0),
