@@ -19,8 +19,6 @@ from __future__ import annotations
 import json
 import math
 import time
-from collections.abc import Iterable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -30,7 +28,7 @@ from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
 from .scenarios import Scenario
-from .sweep import JobProgress, build_controller, check_pushes
+from .sweep import JobProgress, build_controller, check_pushes, run_in_processes
 from .sweep_trial import push_timing
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -155,26 +153,11 @@ def run_grid(spec: GridSpec, workers: int = 1, progress: bool = True) -> list[di
     jobs = all_grid_jobs(spec)
     bar = JobProgress(len(jobs), 0, progress)
     records: dict[GridJob, dict] = {}
-    for job, record in _execute(spec, jobs, workers):
+    arguments = [(spec, job) for job in jobs]
+    for (_, job), record in run_in_processes(_run_grid_job_args, arguments, workers):
         records[job] = record
         bar.advance()
     return [records[job] for job in jobs]
-
-
-def _execute(spec: GridSpec, jobs: list[GridJob], workers: int) -> Iterable[tuple[GridJob, dict]]:
-    if workers == 1:
-        for job in jobs:
-            yield job, run_grid_job(spec, job)
-        return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = {pool.submit(_run_grid_job_args, (spec, job)): job for job in jobs}
-        try:
-            for future in as_completed(futures):
-                yield futures[future], future.result()
-        except BaseException:
-            for future in futures:
-                future.cancel()
-            raise
 
 
 def summarize(spec: GridSpec, records: list[dict]) -> dict:

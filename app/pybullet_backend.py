@@ -583,15 +583,18 @@ class PyBulletBackend:
     ) -> NDArray[np.float64]:
         """Joint targets ``q`` (simulator order) plus the ankle CoP feedback's offsets."""
         stance = command.stance.foot
-        robot = self.ik.robot
-        jacobian = robot.frame_jacobian(self.description.ankle_link(stance), "world")
-        axes = [
-            jacobian[3:6, robot.get_joint_v_offset(name)] for name in self._ankle_joints[stance]
-        ]
+        single_support = not command.double_support
+        axes = []
+        if single_support:  # the offsets only decay in double support
+            robot = self.ik.robot
+            jacobian = robot.frame_jacobian(self.description.ankle_link(stance), "world")
+            axes = [
+                jacobian[3:6, robot.get_joint_v_offset(name)] for name in self._ankle_joints[stance]
+            ]
         offsets = self.ankle.update(
             self.control_period,
             stance,
-            not command.double_support,
+            single_support,
             self._plan_cop,
             self._pressure.get(stance),
             axes,

@@ -89,6 +89,7 @@ class SimulatedRobot:
         self._client_id = client._client
         self._set_motors = pybullet.setJointMotorControlArray
         self._step_simulation = pybullet.stepSimulation
+        self._contacts: tuple | None = None  # contact points of the current state
         self.time = 0.0
 
     # ----------------------------------------------------------------- state
@@ -121,6 +122,7 @@ class SimulatedRobot:
         offset = np.array(position) - np.asarray(base_position, float)
         linear = np.asarray(linear, float) + np.cross(angular, offset)
         self.client.resetBaseVelocity(self.body, list(linear), list(angular))
+        self._contacts = None
         velocities = joint_velocities or {}
         for name, index in zip(self.joint_names, self.joint_indices, strict=True):
             self.client.resetJointState(
@@ -156,8 +158,14 @@ class SimulatedRobot:
 
     def ground_contacts(self) -> set[int]:
         """PyBullet link indices touching the ground (-1: the base)."""
-        points = self.client.getContactPoints(bodyA=self.body, bodyB=self.ground)
-        return {point[3] for point in points}
+        return {point[3] for point in self.contact_points()}
+
+    def contact_points(self) -> tuple:
+        """PyBullet's contact points between the robot and the ground, fetched once per
+        physics state (the fall check and the CoP measurement of a tick share them)."""
+        if self._contacts is None:
+            self._contacts = self.client.getContactPoints(bodyA=self.body, bodyB=self.ground)
+        return self._contacts
 
     def feet_in_contact(self) -> set[str]:
         """Feet whose ankle link touches the ground."""
@@ -170,7 +178,7 @@ class SimulatedRobot:
         Feet without contact are absent.
         """
         sums: dict[int, list[float]] = {}
-        for point in self.client.getContactPoints(bodyA=self.body, bodyB=self.ground):
+        for point in self.contact_points():
             entry = sums.setdefault(point[3], [0.0, 0.0, 0.0])
             force = point[9]
             entry[0] += force * point[6][0]
@@ -228,6 +236,7 @@ class SimulatedRobot:
                 self.body, -1, list(base_force_world), position, pybullet.WORLD_FRAME
             )
         self._step_simulation(physicsClientId=self._client_id)
+        self._contacts = None
         self.time += PHYSICS_TIME_STEP
 
     def close(self) -> None:

@@ -26,11 +26,11 @@ import json
 import math
 import sys
 import time
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Protocol
+from typing import Protocol, TypeVar
 
 import numpy as np
 
@@ -44,6 +44,8 @@ from .scenarios import Scenario
 from .sweep_trial import SettledTrial, push_timing
 
 PLACO_WPG = "placo-wpg"
+T = TypeVar("T")
+R = TypeVar("R")
 
 
 class GridLike(Protocol):
@@ -362,15 +364,24 @@ def _execute(spec: SweepSpec, jobs: list[Job], workers: int, backend: str) -> It
 
         yield from execute_on_ray(spec, jobs, workers)
         return
+    for _, record in run_in_processes(_run_job_args, [(spec, job) for job in jobs], workers):
+        yield record
+
+
+def run_in_processes(
+    function: Callable[[T], R], arguments: list[T], workers: int
+) -> Iterator[tuple[T, R]]:
+    """(argument, result) of ``function`` for each argument, in the order they finish:
+    in this process for one worker, else in a pool (pending work is cancelled on error)."""
     if workers == 1:
-        for job in jobs:
-            yield run_job(spec, job)
+        for argument in arguments:
+            yield argument, function(argument)
         return
     with ProcessPoolExecutor(max_workers=workers) as pool:
-        futures = [pool.submit(_run_job_args, (spec, job)) for job in jobs]
+        futures = {pool.submit(function, argument): argument for argument in arguments}
         try:
             for future in as_completed(futures):
-                yield future.result()
+                yield futures[future], future.result()
         except BaseException:
             for future in futures:
                 future.cancel()
