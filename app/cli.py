@@ -17,6 +17,7 @@ from typing import Any
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 
+from .overrides import add_set_argument
 from .scenarios import BUILT_IN, parse_push
 
 MODELS = ("lipm", "pybullet")
@@ -121,6 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="the RSG without the documented extensions (push hold, leg reach in the "
         "step QP, step reaction time): the paper's jump set and QP (27) as printed",
     )
+    add_set_argument(run)
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     for command in plugin_commands().values():

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from planner.exceptions import ParameterError
 
+from .overrides import add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
 from .sweep import SWEEP_CONTROLLERS
 
@@ -16,6 +17,7 @@ EPILOG = """\
 examples:
   rsg grid --out results/grid-g1          # G1: rsg, fixed-timing, no-step; 4,6,8,10 N s; 8 dirs
   rsg grid --phases 0.25 --controllers rsg --out results/grid-g1-early
+  rsg grid --controllers rsg --set swing_preparation_time=0.3 --out results/grid-g1-tsp03
   rsg grid --model lipm --impulses 20,40,60 --directions 16 --out results/grid-lipm
 
 outputs in --out:
@@ -69,6 +71,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
                    help="the RSG without the documented extensions")  # fmt: skip
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip grid.png")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -89,6 +92,7 @@ def grid_command(args: argparse.Namespace) -> int:
         duration=args.duration,
         settle=args.settle,
         paper_rules=args.paper_rules,
+        overrides=tuple(args.overrides),
     )
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()

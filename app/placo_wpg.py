@@ -129,6 +129,7 @@ from planner.types import Foot, Foothold, MeasuredState, PlannerOutput, StepEven
 from robots.description import RobotDescription
 
 from .backend import InitialCondition
+from .overrides import Overrides
 
 PLANNING_TIME_STEP = 0.05  # [s] target time step of placo's CoM QP
 STEPS_AHEAD = 2  # footsteps planned beyond the current one
@@ -457,17 +458,17 @@ def planner_factory(description: RobotDescription):  # noqa: ANN201
     return build
 
 
-def build_placo_wpg_backend(robot: str):  # noqa: ANN201
+def build_placo_wpg_backend(robot: str, overrides: Overrides = ()):  # noqa: ANN201
     """PyBullet backend, configuration, initial condition and planner factory of placo-wpg.
 
     The backend, IK and configuration are the RSG's (:func:`app.robot_setup.
-    build_robot_backend`); the initial state is placo's plan at t = 0.
+    build_robot_backend`, with ``overrides``); the initial state is placo's plan at
+    t = 0.
     """
-    from robots import get_robot
+    from .robot_setup import build_robot_backend, robot_with_overrides
 
-    from .robot_setup import build_robot_backend
-
-    backend, config, _ = build_robot_backend(robot, "rsg")
-    factory = planner_factory(get_robot(robot))
+    description, _ = robot_with_overrides(robot, overrides)
+    backend, config, _ = build_robot_backend(description, "rsg", overrides)
+    factory = planner_factory(description)
     initial = factory(config).initial_condition()
     return backend, config, initial, factory

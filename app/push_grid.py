@@ -27,6 +27,7 @@ import numpy as np
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
+from .overrides import Overrides
 from .scenarios import Scenario
 from .sweep import JobProgress, build_controller, check_pushes, run_in_processes
 from .sweep_trial import push_timing
@@ -50,6 +51,7 @@ class GridSpec:
         settle: Simulated time after the push start [s].
         paper_rules: The RSG without the documented extensions.
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
+        overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """
 
     model: str = "pybullet"
@@ -63,9 +65,10 @@ class GridSpec:
     settle: float = 4.0
     paper_rules: bool = False
     fall_dcm_error: float = 2.0
+    overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        check_pushes(self.model, self.controllers, self.directions, self.phases)
+        check_pushes(self.model, self.controllers, self.directions, self.phases, self.overrides)
         if not self.impulses or not all(
             math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses
         ):
@@ -219,6 +222,8 @@ def format_grid(spec: GridSpec, records: list[dict]) -> str:
     symbol = {"recovered": "o", "survived": "s", "fell": "x"}
     directions = " ".join(f"{d:g}" for d in spec.directions_deg())
     lines = [f"outcome per direction ({directions} deg): o recovered, s survived, x fell"]
+    if spec.overrides:
+        lines.insert(0, "with " + " ".join(f"--set {n}={v}" for n, v in spec.overrides))
     summary = summarize(spec, records)
     for controller in spec.controllers:
         for phase in spec.phases:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 from planner.parameters import (
     Constraints,
@@ -15,6 +16,13 @@ from robots import get_robot
 from robots.description import RobotDescription
 
 from .backend import InitialCondition
+from .overrides import (
+    Overrides,
+    ParsedOverrides,
+    apply_to_description,
+    apply_to_rsg,
+    parse_overrides,
+)
 from .runner import walking_start
 
 ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the sole's edges
@@ -61,20 +69,38 @@ def planner_config_for(
     )
 
 
-def build_robot_backend(robot: str | RobotDescription, controller: str):  # noqa: ANN201
-    """PyBullet backend, planner configuration and walking start for ``robot``
-    (a registry name or a description).
+def robot_with_overrides(
+    robot: str | RobotDescription, overrides: Overrides = ()
+) -> tuple[RobotDescription, ParsedOverrides]:
+    """The description of ``robot`` (a registry name or a description) with the
+    description fields and backend options of ``overrides`` (``--set``).
 
     Raises:
-        ParameterError: Unknown robot.
+        ParameterError: Unknown robot, or a bad override.
+    """
+    description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
+    parsed = parse_overrides(overrides, "pybullet")
+    return apply_to_description(description, parsed), parsed
+
+
+def build_robot_backend(  # noqa: ANN201
+    robot: str | RobotDescription, controller: str, overrides: Overrides = ()
+):
+    """PyBullet backend, planner configuration and walking start for ``robot``
+    (a registry name or a description), with ``overrides`` (``--set``; RSG
+    parameters are applied to the configuration).
+
+    Raises:
+        ParameterError: Unknown robot, or a bad override.
     """
     from kinematics.swing_foot import SwingTiming
 
     from .pybullet_backend import PyBulletBackend
 
-    description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
+    description, parsed = robot_with_overrides(robot, overrides)
     backend = PyBulletBackend(description, **description.backend_options)
     config = planner_config_for(description, backend.mass, controller)
+    config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
     timing = SwingTiming(
         config.gait.double_support_duration,
         config.rsg.swing_preparation_time,

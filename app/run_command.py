@@ -9,6 +9,7 @@ from pathlib import Path
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 
+from .overrides import as_record
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
@@ -62,6 +63,7 @@ def run_command(args: argparse.Namespace) -> int:
             scenario.reference_mass,
         )
     planner = None
+    overrides = tuple(getattr(args, "overrides", ()))
     if args.controller == "placo-wpg":
         if args.model != "pybullet":
             raise ParameterError(
@@ -72,11 +74,13 @@ def run_command(args: argparse.Namespace) -> int:
             )
         from .placo_wpg import build_placo_wpg_backend
 
-        backend, config, initial, planner = build_placo_wpg_backend(args.robot)
+        backend, config, initial, planner = build_placo_wpg_backend(args.robot, overrides)
     else:
         backend, config, initial = build_backend(
-            args.model, args.robot, args.controller, args.paper_rules
+            args.model, args.robot, args.controller, args.paper_rules, overrides
         )
+    if overrides:
+        print("with " + " ".join(f"--set {name}={value}" for name, value in overrides))
     try:
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:
@@ -93,6 +97,8 @@ def run_command(args: argparse.Namespace) -> int:
             planner=planner,
         )
         result.impulse_scale = factor
+        if overrides:
+            result.extra["overrides"] = as_record(overrides)
     finally:
         backend.close()
     out: Path = args.out

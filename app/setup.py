@@ -10,6 +10,7 @@ from planner.parameters import PlannerConfig
 
 from .backend import Backend, InitialCondition
 from .lipm_backend import LipmBackend
+from .overrides import Overrides, apply_to_rsg, parse_overrides
 from .runner import walking_start
 
 
@@ -25,25 +26,33 @@ def paper_rules(config: PlannerConfig) -> PlannerConfig:
 
 
 def build_backend(
-    model: str, robot: str, controller: str, paper: bool = False
+    model: str, robot: str, controller: str, paper: bool = False, overrides: Overrides = ()
 ) -> tuple[Backend, PlannerConfig, InitialCondition]:
     """The backend for ``model`` and the planner configuration that fits it.
 
     Args:
         model, robot, controller: Names as on the command line.
         paper: The paper's rules only (:func:`paper_rules`).
+        overrides: ``--set`` pairs (:mod:`app.overrides`); RSG parameters among
+            them are applied after ``paper``.
 
     Raises:
-        ParameterError: Unknown model or robot.
+        ParameterError: Unknown model or robot, or a bad override.
     """
     if model == "lipm":
+        parsed = parse_overrides(overrides, "lipm")
         config = PlannerConfig(controller=controller)
         if paper:
             config = paper_rules(config)
+        config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
         return LipmBackend(config.model), config, walking_start(config)
     if model == "pybullet":
-        from .robot_setup import build_robot_backend
+        from .robot_setup import build_robot_backend, robot_with_overrides
 
-        backend, config, initial = build_robot_backend(robot, controller)
-        return backend, paper_rules(config) if paper else config, initial
+        _, parsed = robot_with_overrides(robot, overrides)
+        backend, config, initial = build_robot_backend(robot, controller, overrides)
+        if paper:
+            config = paper_rules(config)
+            config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
+        return backend, config, initial
     raise ParameterError("--model", model, "lipm or pybullet")

@@ -40,6 +40,7 @@ from planner.types import Push
 
 from .bisection import bisect_threshold
 from .capturability import impulse_bound
+from .overrides import Overrides, parse_overrides
 from .scenarios import Scenario
 from .sweep_trial import SettledTrial, push_timing
 
@@ -59,6 +60,8 @@ class GridLike(Protocol):
     def paper_rules(self) -> bool: ...
     @property
     def fall_dcm_error(self) -> float: ...
+    @property
+    def overrides(self) -> Overrides: ...
 
 
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
@@ -66,11 +69,16 @@ JOBS_FILE = "jobs.jsonl"
 SPEC_FILE = "sweep_spec.json"
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
-                 "qp_solver", "criterion", "fall_dcm_error", "paper_rules")  # fmt: skip
+                 "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
+                 "overrides")  # fmt: skip
 
 
 def check_pushes(
-    model: str, controllers: tuple[str, ...], directions: int, phases: tuple[float, ...]
+    model: str,
+    controllers: tuple[str, ...],
+    directions: int,
+    phases: tuple[float, ...],
+    overrides: Overrides = (),
 ) -> None:
     """Validate what a sweep and a push grid share.
 
@@ -95,6 +103,7 @@ def check_pushes(
         raise ParameterError("directions", directions, "an integer in [1, 360]")
     if not phases or not all(0.0 <= p < 1.0 for p in phases):
         raise ParameterError("phases", phases, "fractions in [0, 1)")
+    parse_overrides(overrides, model)
 
 
 @dataclass(frozen=True)
@@ -120,6 +129,7 @@ class SweepSpec:
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
         paper_rules: The RSG without the documented extensions (push hold, leg
             reach in the QP, step reaction time; :func:`app.setup.paper_rules`).
+        overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """
 
     model: str = "lipm"
@@ -136,9 +146,10 @@ class SweepSpec:
     criterion: str = "recovered"
     fall_dcm_error: float = 2.0
     paper_rules: bool = False
+    overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        check_pushes(self.model, self.controllers, self.directions, self.phases)
+        check_pushes(self.model, self.controllers, self.directions, self.phases, self.overrides)
         checks = {
             "duration": (self.duration, 1e-3, 1.0),
             "settle": (self.settle, 1.0, 60.0),
@@ -185,14 +196,16 @@ def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN2
     if controller == PLACO_WPG:
         from .placo_wpg import build_placo_wpg_backend
 
-        return build_placo_wpg_backend(spec.robot)
+        return build_placo_wpg_backend(spec.robot, spec.overrides)
     return (*_build_rsg(spec, controller), None)
 
 
 def _build_rsg(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
     from .setup import build_backend
 
-    backend, config, initial = build_backend(spec.model, spec.robot, controller, spec.paper_rules)
+    backend, config, initial = build_backend(
+        spec.model, spec.robot, controller, spec.paper_rules, spec.overrides
+    )
     if spec.model == "lipm":
         from .lipm_backend import LipmBackend
 
@@ -292,8 +305,10 @@ def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
     if spec_path.is_file():
         old = json.loads(spec_path.read_text())
         defaults = asdict(SweepSpec())
+        new = json.loads(json.dumps(asdict(spec)))  # tuples as JSON lists, as stored
+        defaults = json.loads(json.dumps(defaults))
         for name in RESULT_FIELDS:  # a field missing from an older spec had its default
-            if old.get(name, defaults[name]) != asdict(spec)[name]:
+            if old.get(name, defaults[name]) != new[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",
                     old.get(name),

@@ -11,6 +11,7 @@ from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
+from .overrides import add_set_argument
 from .sweep import PLACO_WPG, SweepSpec, run_sweep
 from .sweep_plot import plot_envelope
 
@@ -82,6 +83,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--backend", choices=("process", "ray"), default="process",
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    add_set_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -109,6 +111,7 @@ def sweep_command(args: argparse.Namespace) -> int:
         tolerance=args.tolerance,
         criterion=criterion,
         paper_rules=args.paper_rules,
+        overrides=tuple(args.overrides),
     )
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()

@@ -13,7 +13,9 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   whole sole, and every early step then causes the next one. Measured again with
   the CoP loops below, on 32 pushes (4-10 N s, 8 directions, 0.1 s): at mid single
   support T_SP 0.2/0.25/0.3/0.4/0.5 s survive 19/21/26/24/19, but at phase 0.25
-  (start of single support) 0.3 s survives 7 and 0.5 s 12, so 0.5 s is kept.
+  (start of single support) 0.3 s survives 7 and 0.5 s 12, so 0.5 s is kept
+  (``rsg grid --controllers rsg --phases 0.5625,0.25 --set swing_preparation_time=0.3
+  --out DIR``; every choice below can be re-measured with ``--set`` the same way).
 * ``step_reaction_time`` 0.2 s with ``swing_acceleration`` 20 m/s^2 and
   ``swing_descent_slope`` 0.5: the planner decides an early step 0.2 s before its
   touchdown and aims the QP at the state predicted then; the swing sole reaches the

@@ -1,0 +1,166 @@
+"""``--set NAME=VALUE``: parsing, where each name applies, its effect, errors."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from app.cli import main
+from app.overrides import allowed_names, parse_assignment, parse_overrides, parse_value
+from app.push_grid import GridSpec
+from app.robot_setup import build_robot_backend, robot_with_overrides
+from app.runner import run_closed_loop
+from app.scenarios import Scenario
+from app.setup import build_backend
+from app.sweep import SweepSpec, run_sweep
+from planner.exceptions import ParameterError
+from planner.types import Push
+
+
+def test_values_are_parsed_by_the_kind_of_the_parameter() -> None:
+    assert parse_value("x", "0.3", "float") == 0.3
+    assert parse_value("x", "0,2", "float | tuple[float, float]") == (0.0, 2.0)
+    assert parse_value("x", "2", "float | tuple[float, float]") == 2.0
+    assert parse_value("x", "none", "float | None") is None
+    assert parse_value("x", "True", "bool") is True
+    assert parse_value("x", "off", "bool") is False
+    assert parse_value("x", "feedback", "str") == "feedback"
+    for text, kind in [("a", "float"), ("1,2", "float"), ("nan", "float"), ("maybe", "bool")]:
+        with pytest.raises(ParameterError) as error:
+            parse_value("x", text, kind)
+        assert error.value.field == "--set x"
+        assert error.value.value == text
+
+
+def test_assignments_need_a_name_and_a_value() -> None:
+    assert parse_assignment(" cop_admittance = 0.2 ") == ("cop_admittance", "0.2")
+    for text in ("cop_admittance", "=0.2", "cop_admittance="):
+        with pytest.raises(argparse.ArgumentTypeError):
+            parse_assignment(text)
+
+
+def test_each_name_goes_where_it_applies() -> None:
+    parsed = parse_overrides(
+        (
+            ("swing_preparation_time", "0.3"),
+            ("cop_feedback", "0,1"),
+            ("foothold_feedback", "false"),
+            ("crossing_margin", "0.03"),
+        )
+    )
+    assert parsed.description == {"swing_preparation_time": 0.3}
+    assert parsed.backend == {"cop_feedback": (0.0, 1.0), "foothold_feedback": False}
+    assert parsed.rsg == {"crossing_margin": 0.03}
+    # On the LIPM only RSG parameters exist, all of them.
+    lipm = parse_overrides((("swing_preparation_time", "0.3"),), "lipm")
+    assert lipm.rsg == {"swing_preparation_time": 0.3}
+    assert "cop_admittance" not in allowed_names("lipm")
+
+
+@pytest.mark.parametrize(
+    ("overrides", "model", "field"),
+    [
+        ((("no_such_parameter", "1"),), "pybullet", "--set"),
+        ((("cop_admittance", "0.2"),), "lipm", "--set"),
+        ((("crossing_margin", "0.03"), ("crossing_margin", "0.04")), "lipm",
+         "--set crossing_margin"),
+        ((("cop_feedback", "1,2,3"),), "pybullet", "--set cop_feedback"),
+    ],
+)  # fmt: skip
+def test_bad_overrides_name_the_parameter(overrides: tuple, model: str, field: str) -> None:
+    with pytest.raises(ParameterError) as error:
+        parse_overrides(overrides, model)
+    assert error.value.field == field
+    if field == "--set":
+        assert "crossing_margin" in error.value.allowed  # the allowed names are listed
+
+
+def test_a_robot_description_takes_fields_and_backend_options() -> None:
+    description, _ = robot_with_overrides(
+        "g1", (("swing_preparation_time", "0.3"), ("cop_admittance", "0.2"))
+    )
+    assert description.swing_preparation_time == 0.3
+    assert description.backend_options["cop_admittance"] == 0.2
+    # The other tuned options are kept.
+    assert description.backend_options["cop_feedback"] == (0.0, 2.0)
+    with pytest.raises(ParameterError) as error:
+        robot_with_overrides("g1", (("com_height", "5"),))
+    assert error.value.field == "com_height"  # the description's own range check
+
+
+def test_the_robot_backend_and_planner_receive_the_overrides() -> None:
+    backend, config, _ = build_robot_backend(
+        "g1",
+        "rsg",
+        (("swing_preparation_time", "0.3"), ("cop_admittance", "0.2"), ("crossing_margin", "0.03")),
+    )
+    try:
+        assert backend.cop_admittance == 0.2
+        assert config.rsg.swing_preparation_time == 0.3
+        assert backend.timing.ready == 0.3  # the swing foot is timed on the same T_SP
+        assert config.rsg.crossing_margin == 0.03
+    finally:
+        backend.close()
+
+
+def test_a_later_earliest_step_keeps_steps_apart_on_the_lipm() -> None:
+    """T_SP bounds how soon after a step the next may come: T_DSP + T_SP (jump set D_T)."""
+    scenario = Scenario("forward", 6.0, (Push(2.4, np.array([40.0, 0.0]), 0.1),))
+
+    def step_intervals(overrides: tuple) -> np.ndarray:
+        backend, config, initial = build_backend("lipm", "g1", "rsg", overrides=overrides)
+        result = run_closed_loop(backend, config, scenario, initial)
+        assert result.recovered
+        return np.diff([step.event["t"] for step in result.steps])
+
+    default = step_intervals(())
+    slow = step_intervals((("swing_preparation_time", "0.5"),))
+    assert default.min() == pytest.approx(0.1 + 0.2)  # the early step: T_DSP + T_SP
+    assert slow.min() == pytest.approx(0.1 + 0.5)
+
+
+def test_paper_rules_then_set(tmp_path: Path) -> None:
+    _, config, _ = build_backend("lipm", "g1", "rsg", paper=True)
+    assert config.rsg.step_reaction_time == 0.0
+    _, config, _ = build_backend(
+        "lipm", "g1", "rsg", paper=True, overrides=(("step_reaction_time", "0.1"),)
+    )
+    assert config.rsg.step_reaction_time == 0.1  # --set wins over --paper-rules
+
+
+def test_the_run_command_records_the_overrides(tmp_path: Path, capsys) -> None:
+    code = main(
+        ["run", "--model", "lipm", "--scenario", "walk", "--duration", "2", "--no-plots",
+         "--quiet", "--set", "crossing_margin=0.03", "--out", str(tmp_path)]
+    )  # fmt: skip
+    assert code in (0, 1)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["overrides"] == {"crossing_margin": "0.03"}
+    assert "--set crossing_margin=0.03" in capsys.readouterr().out
+
+
+def test_a_bad_override_is_a_clear_error_before_any_run(tmp_path: Path, capsys) -> None:
+    code = main(["grid", "--model", "lipm", "--set", "cop_admittance=0.2", "--out", str(tmp_path)])
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "--set" in err and "cop_admittance" in err and "RSG parameters only" in err
+    assert not (tmp_path / "grid.json").exists()
+    with pytest.raises(ParameterError):
+        GridSpec(overrides=(("swing_preparation_time", "soon"),))
+
+
+def test_a_resumed_sweep_must_have_the_same_overrides(tmp_path: Path) -> None:
+    spec = SweepSpec(
+        controllers=("no-step",), directions=1, phases=(0.0,), tolerance=5.0,
+        overrides=(("crossing_margin", "0.05"),),
+    )  # fmt: skip
+    run_sweep(spec, tmp_path, workers=1, progress=False)
+    run_sweep(spec, tmp_path, workers=1, progress=False)  # resumes: nothing left to do
+    other = SweepSpec(**{**spec.__dict__, "overrides": (("crossing_margin", "0.04"),)})
+    with pytest.raises(ParameterError) as error:
+        run_sweep(other, tmp_path, workers=1, progress=False)
+    assert "overrides" in error.value.field
