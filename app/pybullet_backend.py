@@ -125,6 +125,8 @@ from robots import get_robot
 from robots.description import RobotDescription
 
 INITIAL_VELOCITY_HORIZON = 0.01  # [s] finite difference used to start with a CoM velocity
+CONTACT_LOAD_FRACTION = 0.3  # swing-sole load [-, of m g] that counts as a touchdown
+CONTACT_WINDOW = 0.08  # [s] before the planned step in which a touchdown switches the stance
 
 
 class PyBulletBackend:
@@ -169,6 +171,7 @@ class PyBulletBackend:
         foothold_feedback: bool = False,
         cop_feedback: float | tuple[float, float] = 0.0,
         cop_admittance: float = 0.0,
+        stance_switch: str = "planned",
     ) -> None:
         """Load the robot.
 
@@ -238,6 +241,12 @@ class PyBulletBackend:
             cop_admittance: Gain A [-] of the CoM admittance
                 (:func:`app.pybullet_com_plan.cop_admittance_zmp`): the CoM plan is
                 integrated with its CoP moved by A (planned - measured CoP).
+            stance_switch: ``"planned"``: the stance switches at the planner's jump
+                (its planned step time); ``"contact"``: also when the swing sole
+                carries :data:`CONTACT_LOAD_FRACTION` of the weight within
+                :data:`CONTACT_WINDOW` of the planned step, the measured state then
+                reports the sole's position as ``touchdown`` and the planner jumps
+                onto it at once.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -294,6 +303,10 @@ class PyBulletBackend:
         if not 0.0 <= cop_admittance <= 2.0:
             raise ParameterError("cop_admittance", cop_admittance, "in [0, 2]")
         self.cop_admittance = cop_admittance
+        if stance_switch not in ("planned", "contact"):
+            raise ParameterError("stance_switch", stance_switch, "planned or contact")
+        self.stance_switch = stance_switch
+        self._last_command: PlannerOutput | None = None
         self._plan_cop = np.zeros(2)  # CoP of the CoM plan over the last tick [m]
         self._pressure: dict[str, tuple[NDArray[np.float64], float]] = {}
         if not 0.0 <= landing_clearance <= 0.01:
@@ -374,6 +387,7 @@ class PyBulletBackend:
         self.swing.start(np.asarray(initial.swing.position, float))
         self.timers.clear()
         self.ticks = 0
+        self._last_command = None
         self._measured = self._measure()
         self._com_reference = com_xy.copy()
         self._com_velocity_reference = com_velocity.copy()
@@ -420,6 +434,7 @@ class PyBulletBackend:
             + self.landing_delay
             - self.touchdown_lead
         )
+        self._last_command = command
         self.landing.observe(command)
         target = self.landing.target(command)
         if self.foothold_feedback:
@@ -614,10 +629,25 @@ class PyBulletBackend:
         return np.asarray(moment / total, dtype=float)
 
     def _measure(self) -> MeasuredState:
-        if self.ankle.enabled or self.cop_admittance > 0.0:
+        if self.ankle.enabled or self.cop_admittance > 0.0 or self.stance_switch == "contact":
             self._pressure = self.sim.foot_pressure()
         com, com_velocity = self.sim.com_state()
-        return MeasuredState(self.sim.time, com[:2].copy(), com_velocity[:2].copy())
+        return MeasuredState(
+            self.sim.time, com[:2].copy(), com_velocity[:2].copy(), self._touchdown()
+        )
+
+    def _touchdown(self) -> NDArray[np.float64] | None:
+        """Where the swing sole touched down [m] (``stance_switch="contact"``), else None."""
+        command = self._last_command
+        if self.stance_switch != "contact" or command is None or command.double_support:
+            return None
+        swing = other_foot(command.stance.foot)
+        load = self._pressure.get(swing)
+        if load is None or load[1] < CONTACT_LOAD_FRACTION * self.mass * GRAVITY:
+            return None
+        if not 0.0 < command.next_step_time - self.sim.time <= CONTACT_WINDOW:
+            return None
+        return np.asarray(self.sim.sole_position(swing)[:2], dtype=float)
 
     # ---------------------------------------------------------------- queries
     def fall_status(self) -> FallStatus:

@@ -241,7 +241,9 @@ class ClosedLoop:
         """Run one control tick; returns the planner's output for it."""
         start = wallclock.perf_counter()
         time = self.time
-        measured = MeasuredState(time, self.measured.com_position, self.measured.com_velocity)
+        measured = MeasuredState(
+            time, self.measured.com_position, self.measured.com_velocity, self.measured.touchdown
+        )
         out = self.generator.update(measured, self.period)
         if out.step is not None:
             step = out.stance.position - out.previous_stance.position

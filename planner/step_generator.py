@@ -62,6 +62,11 @@ as s~_td approaches. At s~_td the jump happens with the QP at that tick's state,
 in the paper. The touchdown time is fixed when the decision is made, so the
 foothold converges as the prediction horizon shrinks.
 
+A backend that switches the stance at measured contact reports the touchdown in
+``MeasuredState.touchdown``: in single support the planner then jumps at once, onto
+that foothold, before its own jump time (a timing jump). The default backends do not:
+the jump happens at the planned time (why: README, "When does the stance switch?").
+
 Controllers in the same framework (``PlannerConfig.controller``):
 
 - ``rsg``: all of the above;
@@ -161,6 +166,9 @@ class ReactiveStepGenerator:
     def earliest_step(self) -> float:
         """T_DSP + T_SP, the earliest s~ at which the swing foot can land [s]."""
         return self.config.gait.double_support_duration + self.config.rsg.swing_preparation_time
+
+    def _in_double_support(self) -> bool:
+        return self.time_since_step < self.config.gait.double_support_duration
 
     def _ready_to_step(self, lead: float = 0.0) -> bool:
         """s~ + ``lead`` >= T_DSP + T_SP."""
@@ -331,6 +339,12 @@ class ReactiveStepGenerator:
             and self._ready_to_step()
             and self.reference.in_nominal_jump_set()
         )
+        touchdown = measured.touchdown
+        if touchdown is not None and not (timing or nominal) and not self._in_double_support():
+            # The backend switches the stance at measured contact: the jump is now, onto
+            # the foot where it touched down.
+            timing = True
+            self.announced_step = np.asarray(touchdown, dtype=float).copy()
         if timing or nominal:
             if timing and self.announced_step is not None:
                 # The swing foot was sent to the foothold announced last tick: it lands there.

@@ -76,11 +76,15 @@ class MeasuredState:
         time: Time [s].
         com_position: Horizontal CoM c_H in the world [m], shape (2,).
         com_velocity: Horizontal CoM velocity [m/s], shape (2,).
+        touchdown: Where the swing foot has just touched the ground [m], shape (2,),
+            when the backend switches the stance at measured contact; None otherwise
+            (the planner then steps at its own jump time).
     """
 
     time: float
     com_position: Vector2
     com_velocity: Vector2
+    touchdown: Vector2 | None = None
 
 
 @dataclass(frozen=True)

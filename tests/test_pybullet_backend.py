@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.backend import InitialCondition
-from app.pybullet_backend import PyBulletBackend
+from app.pybullet_backend import CONTACT_WINDOW, PyBulletBackend
 from app.pybullet_com_plan import ADMITTANCE_LIMIT, clip_to_hull, cop_admittance_zmp
 from planner.exceptions import ParameterError
 from planner.types import Foothold, PlannerOutput, StepEvent
@@ -118,6 +118,7 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
         {"cop_feedback": -1.0},
         {"cop_admittance": -0.1},
         {"cop_admittance": 3.0},
+        {"stance_switch": "early"},
     ],
 )
 def test_walking_options_are_validated(options):
@@ -285,3 +286,29 @@ def test_foothold_feedback_aims_the_swing_foot_against_the_stance_offset():
         assert backend._stance_offset[0] == pytest.approx(-0.01, abs=0.004)
     finally:
         backend.close()
+
+
+@pytest.mark.parametrize("switch", ["planned", "contact"])
+def test_a_touchdown_is_reported_only_when_the_stance_switches_at_contact(switch):
+    """The swing sole landing under load within CONTACT_WINDOW of the planned step is a
+    touchdown at the measured sole, for ``stance_switch="contact"`` only."""
+    backend = PyBulletBackend("g1", stance_switch=switch)
+    try:
+        over_left = LEFT.position.copy()
+        backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+        touchdowns = []
+        for tick in range(round(0.8 / backend.control_period)):
+            time = tick * backend.control_period
+            state = backend.step(command(time, over_left, since_step=time), np.zeros(2))
+            if state.touchdown is not None:
+                touchdowns.append((state.time, state.touchdown))
+        assert not backend.fall_status().fell
+    finally:
+        backend.close()
+    if switch == "planned":
+        assert touchdowns == []
+        return
+    assert touchdowns, "the swing foot lands at 0.8 s under load"
+    for time, position in touchdowns:
+        assert 0.8 - CONTACT_WINDOW <= time < 0.8
+        np.testing.assert_allclose(position, RIGHT.position, atol=0.01)

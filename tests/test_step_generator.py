@@ -291,3 +291,29 @@ def test_step_reaction_time_is_validated():
 
     with pytest.raises(ParameterError, match="step_reaction_time"):
         _reaction_config(-0.1)
+
+
+def test_a_measured_touchdown_is_a_jump_onto_it_in_single_support_only():
+    """MeasuredState.touchdown: the backend switched the stance at contact (19b at that
+    foothold, a timing jump); in the double support it is ignored."""
+    config = PlannerConfig()
+    gen = ReactiveStepGenerator(config)
+    gen.reset(
+        Foothold("left", np.array([0.0, 0.1])),
+        Foothold("right", np.array([-0.2, -0.1])),
+        time_since_step=0.05,  # double support
+    )
+    com, velocity = gen.initial_com_state()
+    landed = np.array([0.21, -0.12])
+    out = gen.update(MeasuredState(0.0, com, velocity, touchdown=landed), 0.01)
+    assert out.step is None
+    gen.time_since_step = 0.6  # single support, before the nominal jump at 0.8 s
+    com, velocity = gen.initial_com_state()
+    xi = np.r_[com - gen.stance, velocity]
+    error_before, reference_xi1 = gen.dcm_error(xi), gen.reference.xi1.copy()
+    out = gen.update(MeasuredState(0.01, com, velocity, touchdown=landed), 0.01)
+    assert out.step is not None and out.step.timing_adjusted
+    np.testing.assert_allclose(out.stance.position, landed)
+    assert out.stance.foot == "right"
+    u_d = landed - np.array([0.0, 0.1])
+    np.testing.assert_allclose(out.dcm_error, error_before - u_d + 2 * reference_xi1, atol=1e-9)
