@@ -11,6 +11,7 @@ from planner.exceptions import ParameterError
 
 from .overrides import add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
+from .robot_setup import check_robot_overrides
 from .sweep import SWEEP_CONTROLLERS
 
 EPILOG = """\
@@ -94,6 +95,8 @@ def grid_command(args: argparse.Namespace) -> int:
         paper_rules=args.paper_rules,
         overrides=tuple(args.overrides),
     )
+    if spec.model == "pybullet":
+        check_robot_overrides(spec.robot, spec.overrides)
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()
     records = run_grid(spec, workers, progress=not args.quiet)

@@ -154,7 +154,7 @@ def run_grid(spec: GridSpec, workers: int = 1, progress: bool = True) -> list[di
     if not (isinstance(workers, int) and 1 <= workers <= 1024):
         raise ParameterError("--workers", workers, "an integer in [1, 1024]")
     jobs = all_grid_jobs(spec)
-    bar = JobProgress(len(jobs), 0, progress)
+    bar = JobProgress(len(jobs), 0, progress, label="grid", unit="runs")
     records: dict[GridJob, dict] = {}
     arguments = [(spec, job) for job in jobs]
     for (_, job), record in run_in_processes(_run_grid_job_args, arguments, workers):

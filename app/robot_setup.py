@@ -110,3 +110,17 @@ def build_robot_backend(  # noqa: ANN201
     backend.swing.timing = timing
     initial: InitialCondition = walking_start(config)
     return backend, config, initial
+
+
+def check_robot_overrides(robot: str, overrides: Overrides) -> None:
+    """Build ``robot`` once with ``overrides`` (then close it), so that a value out of
+    range is reported, as the backend or the planner words it, before a grid or a
+    sweep starts its worker processes.
+
+    Raises:
+        ParameterError: Unknown robot, or a bad override.
+    """
+    if not overrides:
+        return
+    backend, _, _ = build_robot_backend(robot, "rsg", overrides)
+    backend.close()

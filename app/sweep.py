@@ -270,8 +270,16 @@ def _run_job_args(args: tuple[SweepSpec, Job]) -> dict:
 class JobProgress:
     """``done/total`` bar with elapsed time and estimate, on stderr."""
 
-    def __init__(self, total: int, done: int = 0, enabled: bool = True) -> None:
+    def __init__(
+        self,
+        total: int,
+        done: int = 0,
+        enabled: bool = True,
+        label: str = "sweep",
+        unit: str = "jobs",
+    ) -> None:
         self.total, self.done, self.enabled = total, done, enabled
+        self.label, self.unit = label, unit
         self.started = time.perf_counter()
         self.new = 0
         self.show()
@@ -290,7 +298,8 @@ class JobProgress:
         eta = f"~{left:.0f} s left" if math.isfinite(left) else ""
         end = "\n" if self.done >= self.total else ""
         sys.stderr.write(
-            f"\rsweep [{bar:<25}] {self.done}/{self.total} jobs {elapsed:.0f} s {eta:<16}{end}"
+            f"\r{self.label} [{bar:<25}] {self.done}/{self.total} {self.unit} {elapsed:.0f} s "
+            f"{eta:<16}{end}"
         )
         sys.stderr.flush()
 

@@ -12,6 +12,7 @@ from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
 from .overrides import add_set_argument
+from .robot_setup import check_robot_overrides
 from .sweep import PLACO_WPG, SweepSpec, run_sweep
 from .sweep_plot import plot_envelope
 
@@ -113,6 +114,8 @@ def sweep_command(args: argparse.Namespace) -> int:
         paper_rules=args.paper_rules,
         overrides=tuple(args.overrides),
     )
+    if spec.model == "pybullet":
+        check_robot_overrides(spec.robot, spec.overrides)
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()
     records = run_sweep(spec, args.out, workers, args.backend, progress=not args.quiet)

@@ -23,7 +23,7 @@ target, which the caller computes from the measured state.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import pinocchio
@@ -54,6 +54,9 @@ class IkInfeasibleError(RsgError):
             f"whole-body IK infeasible with support {support!r} and CoM target "
             f"{np.round(com_target, 3).tolist()} m: {reason}"
         )
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.support, self.com_target, self.reason))
 
 
 FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]

@@ -29,6 +29,10 @@ class ParameterError(RsgError, ValueError):
         self.allowed = allowed
         super().__init__(f"{field}={value!r} is not allowed: expected {allowed}")
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Rebuilt from its data, so it crosses process boundaries (sweep and grid workers).
+        return (type(self), (self.field, self.value, self.allowed))
+
 
 class StepQpError(RsgError):
     """The step-location QP (27) failed in a way its fallback cannot handle.
@@ -42,3 +46,6 @@ class StepQpError(RsgError):
         self.reason = reason
         self.problem = problem
         super().__init__(reason)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.reason, self.problem))

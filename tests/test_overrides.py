@@ -164,3 +164,18 @@ def test_a_resumed_sweep_must_have_the_same_overrides(tmp_path: Path) -> None:
     with pytest.raises(ParameterError) as error:
         run_sweep(other, tmp_path, workers=1, progress=False)
     assert "overrides" in error.value.field
+
+
+def test_an_error_in_a_worker_process_reaches_the_command_with_its_data(tmp_path: Path, capsys):
+    """An RSG parameter out of range is found when each worker builds its planner; the
+    error crosses the process boundary intact (exit 2, the broken rule named: the
+    nominal step width must exceed 2 w_y + mu_2, here 0.14 + 5 m)."""
+    code = main(
+        ["grid", "--model", "lipm", "--controllers", "rsg", "--impulses", "20",
+         "--directions", "2", "--workers", "2", "--set", "crossing_margin=5",
+         "--out", str(tmp_path)]
+    )  # fmt: skip
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "step_width=0.2 is not allowed" in err and "2 w_y + mu_2 = 5.140 m" in err
+    assert "Traceback" not in err

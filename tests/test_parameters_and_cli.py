@@ -1,15 +1,18 @@
 """Bad input is refused with a message naming the field; rsg run writes its files."""
 
 import json
+import pickle
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from app.cli import main
 from app.scenarios import load_scenario, parse_push
-from planner.exceptions import ParameterError
+from kinematics.whole_body_ik import IkInfeasibleError
+from planner.exceptions import ParameterError, StepQpError
 from planner.parameters import Constraints, GaitParameters, LipmModel, PlannerConfig, RsgParameters
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -161,3 +164,18 @@ def test_rsg_run_writes_summary_timeseries_and_plots(tmp_path):
         assert column in header, column
     for name in ("fig6a_top_view.png", "fig6b_time_since_step.png", "fig6c_dcm_error.png"):
         assert (out / name).stat().st_size > 10_000, name
+
+
+@pytest.mark.parametrize(
+    "error",
+    [
+        ParameterError("impulses", (-1.0,), "impulses in (0, 1000] N s"),
+        StepQpError("no step meets (27b)-(27d)", {"target": [0.1, 0.2]}),
+        IkInfeasibleError("left", np.array([0.1, 0.2]), "hard tasks"),
+    ],
+)
+def test_project_errors_keep_their_data_across_processes(error):
+    """Sweep and grid workers send errors back pickled."""
+    copy = pickle.loads(pickle.dumps(error))
+    assert type(copy) is type(error) and str(copy) == str(error)
+    assert {k: str(v) for k, v in vars(copy).items()} == {k: str(v) for k, v in vars(error).items()}
