@@ -7,8 +7,6 @@ import os
 import time
 from pathlib import Path
 
-from planner.exceptions import ParameterError
-
 from .overrides import add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
 from .robot_setup import check_robot_overrides
@@ -80,9 +78,6 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
 def grid_command(args: argparse.Namespace) -> int:
     """Run ``rsg grid``; returns 0."""
     controllers = tuple(c.strip() for c in args.controllers.split(",") if c.strip())
-    if "placo-wpg" in controllers and args.model == "lipm":
-        raise ParameterError("--controllers", "placo-wpg", "controllers without placo-wpg on "
-                             "--model lipm (placo-wpg drives the full robot's IK)")  # fmt: skip
     spec = GridSpec(
         model=args.model,
         robot=args.robot,

@@ -215,8 +215,3 @@ def apply_to_description(
 def apply_to_rsg(rsg: RsgParameters, parsed: ParsedOverrides) -> RsgParameters:
     """``rsg`` with the RSG parameters of ``parsed`` (validated by RsgParameters)."""
     return dataclasses.replace(rsg, **parsed.rsg) if parsed.rsg else rsg
-
-
-def as_record(overrides: Overrides) -> dict[str, str]:
-    """The overrides for a results file: name -> value text."""
-    return dict(overrides)

@@ -465,10 +465,9 @@ def build_placo_wpg_backend(robot: str, overrides: Overrides = ()):  # noqa: ANN
     build_robot_backend`, with ``overrides``); the initial state is placo's plan at
     t = 0.
     """
-    from .robot_setup import build_robot_backend, robot_with_overrides
+    from .robot_setup import build_robot_backend
 
-    description, _ = robot_with_overrides(robot, overrides)
-    backend, config, _ = build_robot_backend(description, "rsg", overrides)
-    factory = planner_factory(description)
+    backend, config, _ = build_robot_backend(robot, "rsg", overrides)
+    factory = planner_factory(backend.description)
     initial = factory(config).initial_condition()
     return backend, config, initial, factory

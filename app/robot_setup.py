@@ -84,11 +84,13 @@ def robot_with_overrides(
 
 
 def build_robot_backend(  # noqa: ANN201
-    robot: str | RobotDescription, controller: str, overrides: Overrides = ()
+    robot: str | RobotDescription, controller: str, overrides: Overrides = (), paper: bool = False
 ):
     """PyBullet backend, planner configuration and walking start for ``robot``
     (a registry name or a description), with ``overrides`` (``--set``; RSG
-    parameters are applied to the configuration).
+    parameters are applied to the configuration, after the paper's rules when
+    ``paper``, :func:`app.setup.paper_rules`). The backend's ``description`` is the
+    one with the overrides.
 
     Raises:
         ParameterError: Unknown robot, or a bad override.
@@ -96,10 +98,13 @@ def build_robot_backend(  # noqa: ANN201
     from kinematics.swing_foot import SwingTiming
 
     from .pybullet_backend import PyBulletBackend
+    from .setup import paper_rules
 
     description, parsed = robot_with_overrides(robot, overrides)
     backend = PyBulletBackend(description, **description.backend_options)
     config = planner_config_for(description, backend.mass, controller)
+    if paper:
+        config = paper_rules(config)
     config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
     timing = SwingTiming(
         config.gait.double_support_duration,

@@ -9,7 +9,6 @@ from pathlib import Path
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 
-from .overrides import as_record
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
@@ -63,7 +62,7 @@ def run_command(args: argparse.Namespace) -> int:
             scenario.reference_mass,
         )
     planner = None
-    overrides = tuple(getattr(args, "overrides", ()))
+    overrides = tuple(args.overrides)
     if args.controller == "placo-wpg":
         if args.model != "pybullet":
             raise ParameterError(
@@ -98,7 +97,7 @@ def run_command(args: argparse.Namespace) -> int:
         )
         result.impulse_scale = factor
         if overrides:
-            result.extra["overrides"] = as_record(overrides)
+            result.extra["overrides"] = dict(overrides)
     finally:
         backend.close()
     out: Path = args.out

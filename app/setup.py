@@ -47,12 +47,7 @@ def build_backend(
         config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
         return LipmBackend(config.model), config, walking_start(config)
     if model == "pybullet":
-        from .robot_setup import build_robot_backend, robot_with_overrides
+        from .robot_setup import build_robot_backend
 
-        _, parsed = robot_with_overrides(robot, overrides)
-        backend, config, initial = build_robot_backend(robot, controller, overrides)
-        if paper:
-            config = paper_rules(config)
-            config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
-        return backend, config, initial
+        return build_robot_backend(robot, controller, overrides, paper)
     raise ParameterError("--model", model, "lipm or pybullet")

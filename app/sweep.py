@@ -313,9 +313,8 @@ def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
     spec_path = out / SPEC_FILE
     if spec_path.is_file():
         old = json.loads(spec_path.read_text())
-        defaults = asdict(SweepSpec())
-        new = json.loads(json.dumps(asdict(spec)))  # tuples as JSON lists, as stored
-        defaults = json.loads(json.dumps(defaults))
+        # Tuples as JSON lists, as stored.
+        new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, SweepSpec()))
         for name in RESULT_FIELDS:  # a field missing from an older spec had its default
             if old.get(name, defaults[name]) != new[name]:
                 raise ParameterError(

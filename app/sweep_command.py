@@ -7,7 +7,6 @@ import os
 import time
 from pathlib import Path
 
-from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
@@ -94,11 +93,6 @@ def sweep_command(args: argparse.Namespace) -> int:
     if controllers is None:
         with_wpg = args.model == "pybullet"
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
-    elif PLACO_WPG in controllers and args.model == "lipm":
-        raise ParameterError(
-            "--controllers", PLACO_WPG, "controllers without placo-wpg on --model lipm "
-            "(placo-wpg drives the full robot's IK: use --model pybullet)"
-        )  # fmt: skip
     criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
     spec = SweepSpec(
         model=args.model,

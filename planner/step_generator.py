@@ -390,7 +390,7 @@ class ReactiveStepGenerator:
             next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi, nominal_wait, error)),
             next_step_time=self.predicted_step_time(measured.time, level, nominal_wait),
             time_since_step=self.time_since_step,
-            double_support=self.time_since_step < self.config.gait.double_support_duration,
+            double_support=self._in_double_support(),
             dcm_error=error,
             lyapunov=level,
             lyapunov_at_step=self.lyapunov_at_step,
