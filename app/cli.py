@@ -17,7 +17,7 @@ from typing import Any
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 
-from .overrides import add_set_argument
+from .overrides import add_robot_argument, add_set_argument
 from .scenarios import BUILT_IN, parse_push
 
 MODELS = ("lipm", "pybullet")
@@ -87,7 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=DEFAULT_MODEL,
         help=f"simulation backend (default: {DEFAULT_MODEL})",
     )
-    run.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    add_robot_argument(run)
     run.add_argument(
         "--controller",
         choices=(*CONTROLLERS, "placo-wpg"),

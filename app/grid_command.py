@@ -7,7 +7,7 @@ import os
 import time
 from pathlib import Path
 
-from .overrides import add_set_argument
+from .overrides import add_robot_argument, add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
 from .robot_setup import check_robot_overrides
 from .sweep import SWEEP_CONTROLLERS
@@ -51,7 +51,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--model", choices=("lipm", "pybullet"), default="pybullet")
-    p.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    add_robot_argument(p)
     p.add_argument(
         "--controllers",
         default="rsg,fixed-timing,no-step",

@@ -1,4 +1,5 @@
-"""``grid.png``: the outcome of each push, one panel per controller and phase."""
+"""``grid.png``: the outcome of each push, one panel per controller and phase; a
+black dot marks a push above its LIPM capture bound."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.colors import ListedColormap  # noqa: E402
 
-from .push_grid import OUTCOMES, GridSpec  # noqa: E402
+from .push_grid import OUTCOMES, GridSpec, beyond_bound  # noqa: E402
 
 COLOURS = {"recovered": "#2a9d3a", "survived": "#f2c14e", "fell": "#c0392b"}
 
@@ -26,20 +27,28 @@ def plot_grid(spec: GridSpec, records: list[dict], path: Path) -> Path:
     colormap = ListedColormap([COLOURS[o] for o in OUTCOMES])
     for axis, (controller, phase) in zip(axes[0], panels, strict=True):
         matrix = np.full((len(spec.impulses), len(directions)), np.nan)
+        beyond = []
         for record in records:
             if record["controller"] == controller and record["phase"] == phase:
                 row = spec.impulses.index(record["impulse"])
                 column = directions.index(record["direction_deg"])
                 matrix[row, column] = OUTCOMES.index(record["outcome"])
+                if beyond_bound(record):
+                    beyond.append((column, row))
         axis.imshow(matrix, cmap=colormap, vmin=-0.5, vmax=2.5, origin="lower", aspect="auto")
+        if beyond:
+            columns, rows = zip(*beyond, strict=True)
+            axis.plot(columns, rows, "k.", markersize=6)
         not_fallen = int(np.sum(matrix < 2))
         axis.set_title(f"{controller}, phase {phase:g}\nnot fallen {not_fallen}/{matrix.size}")
         axis.set_xticks(range(len(directions)), [f"{d:g}" for d in directions], fontsize=7)
         axis.set_yticks(range(len(spec.impulses)), [f"{i:g}" for i in spec.impulses])
         axis.set_xlabel("push direction [deg] (0 forward, 90 left)")
         axis.set_ylabel("impulse [N s]")
-    handles = [plt.Rectangle((0, 0), 1, 1, color=COLOURS[o]) for o in OUTCOMES]
-    figure.legend(handles, OUTCOMES, loc="lower center", ncol=3, frameon=False)
+    handles: list = [plt.Rectangle((0, 0), 1, 1, color=COLOURS[o]) for o in OUTCOMES]
+    handles.append(plt.Line2D([], [], color="k", marker=".", linestyle="none"))
+    labels = [*OUTCOMES, "above the LIPM capture bound"]
+    figure.legend(handles, labels, loc="lower center", ncol=4, frameon=False)
     figure.tight_layout(rect=(0.0, 0.08, 1.0, 1.0))
     figure.savefig(path, dpi=120)
     plt.close(figure)

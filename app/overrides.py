@@ -13,8 +13,11 @@ A name is looked up in this order:
    ``cop_feedback``, ``swing_descent_slope``, ``landing_clearance``, ...);
 3. a parameter of the RSG (:class:`planner.parameters.RsgParameters`) that the
    description does not set (``crossing_margin``, ``step_decrease_margin``,
-   ``push_hold_time``, ...). On ``--model lipm`` every RSG parameter may be set,
-   and nothing else.
+   ``push_hold_time``, ...).
+
+On ``--model lipm`` (the paper's point mass) every RSG parameter may be set, and
+nothing else. On ``--model lipm --robot NAME`` (the robot's planner on the point
+mass) the description fields and the RSG parameters of 1. and 3. may be set.
 
 RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
@@ -79,21 +82,41 @@ def backend_option_types() -> dict[str, str]:
     }
 
 
-def rsg_parameter_types(model: str = "pybullet") -> dict[str, str]:
+def _paper_point_mass(model: str, robot: str | None) -> bool:
+    """The paper's LIPM (no robot description involved)."""
+    return model == "lipm" and robot is None
+
+
+def rsg_parameter_types(model: str = "pybullet", robot: str | None = None) -> dict[str, str]:
     """RSG parameters ``--set`` may change on ``model`` -> ``"float"``: all of them on
-    the LIPM; on a robot those its description does not set."""
+    the paper's LIPM; with a robot those its description does not set."""
+    paper = _paper_point_mass(model, robot)
     return {
         f.name: "float"
         for f in dataclasses.fields(RsgParameters)
-        if model == "lipm" or (f.name not in DESCRIPTION_FIELDS and not f.name.startswith("lqr_"))
+        if paper or (f.name not in DESCRIPTION_FIELDS and not f.name.startswith("lqr_"))
     }
 
 
-def allowed_names(model: str = "pybullet") -> list[str]:
-    """Every name ``--set`` accepts on ``model``."""
-    if model == "lipm":
-        return sorted(rsg_parameter_types("lipm"))
-    return sorted({**DESCRIPTION_FIELDS, **backend_option_types(), **rsg_parameter_types()})
+def allowed_names(model: str = "pybullet", robot: str | None = None) -> list[str]:
+    """Every name ``--set`` accepts on ``model`` (with ``robot``: ``None`` on the LIPM
+    is the paper's point mass)."""
+    if _paper_point_mass(model, robot):
+        return sorted(rsg_parameter_types("lipm", None))
+    backend = backend_option_types() if model == "pybullet" else {}
+    return sorted({**DESCRIPTION_FIELDS, **backend, **rsg_parameter_types(model, robot)})
+
+
+def add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    """Add ``--robot`` to a command's parser (default ``None``: G1 on ``pybullet``,
+    the paper's point mass on ``lipm``)."""
+    parser.add_argument(
+        "--robot",
+        default=None,
+        help="robot (default: g1 on --model pybullet; on --model lipm the paper's point "
+        "mass, or with --robot that robot's planner: its mass, sole, gait and timing on "
+        "the point mass)",
+    )
 
 
 def add_set_argument(parser: argparse.ArgumentParser) -> None:
@@ -173,8 +196,11 @@ class ParsedOverrides:
     rsg: Mapping[str, Any]
 
 
-def parse_overrides(overrides: Overrides, model: str = "pybullet") -> ParsedOverrides:
-    """Sort and parse ``overrides`` for ``model``.
+def parse_overrides(
+    overrides: Overrides, model: str = "pybullet", robot: str | None = None
+) -> ParsedOverrides:
+    """Sort and parse ``overrides`` for ``model`` with ``robot`` (``None`` on the LIPM:
+    the paper's point mass).
 
     Raises:
         ParameterError: An unknown name (the message lists the allowed ones), a name
@@ -183,22 +209,29 @@ def parse_overrides(overrides: Overrides, model: str = "pybullet") -> ParsedOver
     description: dict[str, Any] = {}
     backend: dict[str, Any] = {}
     rsg: dict[str, Any] = {}
+    paper = _paper_point_mass(model, robot)
     backend_types = backend_option_types() if model == "pybullet" else {}
-    rsg_types = rsg_parameter_types(model)
+    rsg_types = rsg_parameter_types(model, robot)
     seen: set[str] = set()
     for name, text in overrides:
         if name in seen:
             raise ParameterError(f"--set {name}", text, "each name at most once")
         seen.add(name)
-        if model == "pybullet" and name in DESCRIPTION_FIELDS:
+        if not paper and name in DESCRIPTION_FIELDS:
             description[name] = parse_value(name, text, DESCRIPTION_FIELDS[name])
         elif name in backend_types:
             backend[name] = parse_value(name, text, backend_types[name])
         elif name in rsg_types:
             rsg[name] = parse_value(name, text, rsg_types[name])
         else:
-            where = "" if model == "pybullet" else " (--model lipm: RSG parameters only)"
-            raise ParameterError("--set", name, f"one of{where}: {', '.join(allowed_names(model))}")
+            if paper:
+                where = " (--model lipm: RSG parameters only)"
+            elif model == "pybullet":
+                where = ""
+            else:
+                where = " (--model lipm with a robot: no backend options)"
+            allowed = ", ".join(allowed_names(model, robot))
+            raise ParameterError("--set", name, f"one of{where}: {allowed}")
     return ParsedOverrides(description, backend, rsg)
 
 

@@ -11,6 +11,12 @@ bisection can stop at any of several thresholds. The grid runs each
 * ``survived``: no fall within ``settle`` after the push start;
 * ``fell``.
 
+Each record also carries the push's capture bound (:func:`app.capturability.impulse_bound`
+with the controller's configuration: the largest impulse in that direction and at
+that time that any stepping controller could recover on the LIPM with the robot's
+ZMP window, step bounds and step timing). A fall above it is a limit of the robot's
+parameters, not of a controller; the printed grid writes those outcomes in capitals.
+
 Counts over the grid compare controllers without the monotonicity assumption.
 """
 
@@ -27,9 +33,10 @@ import numpy as np
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
+from .capturability import impulse_bound
 from .overrides import Overrides
 from .scenarios import Scenario
-from .sweep import JobProgress, build_controller, check_pushes, run_in_processes
+from .sweep import JobProgress, build_controller, check_pushes, resolve_robot, run_in_processes
 from .sweep_trial import push_timing
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -41,7 +48,8 @@ class GridSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: Robot for ``pybullet``.
+        robot: The robot (:func:`app.sweep.resolve_robot`: ``None`` is G1 on
+            ``pybullet`` and the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         impulses: Push impulses [N s].
         directions: Number of push directions, evenly spaced from 0 (forward).
@@ -55,7 +63,7 @@ class GridSpec:
     """
 
     model: str = "pybullet"
-    robot: str = "g1"
+    robot: str | None = None
     controllers: tuple[str, ...] = ("rsg", "fixed-timing", "no-step")
     impulses: tuple[float, ...] = (4.0, 6.0, 8.0, 10.0)
     directions: int = 8
@@ -68,7 +76,10 @@ class GridSpec:
     overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        check_pushes(self.model, self.controllers, self.directions, self.phases, self.overrides)
+        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        check_pushes(
+            self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
+        )
         if not self.impulses or not all(
             math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses
         ):
@@ -115,8 +126,9 @@ def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
     runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
     options = {} if planner is None else {"planner": planner}
     try:
-        t_push, sigma, _ = push_timing(config, spec.cycle, job.phase)
+        t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
         angle = math.radians(job.direction_deg)
+        bound = impulse_bound(config, angle, sigma, since, spec.duration)
         direction = np.array([math.cos(angle), math.sin(angle)])
         push = Push(t_push, job.impulse * direction, spec.duration)
         scenario = Scenario("grid", t_push + spec.settle, (push,))
@@ -134,6 +146,7 @@ def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
         "outcome": outcome,
         "push_time": t_push,
         "stance": "left" if sigma > 0 else "right",
+        "capture_bound": bound,
         "end_time": result.sim_time,
         "fall_reason": result.fall.reason,
         "adjusted_steps": sum(bool(s.event["adjusted"]) for s in result.steps),
@@ -180,10 +193,17 @@ def summarize(spec: GridSpec, records: list[dict]) -> dict:
     return summary
 
 
+def beyond_bound(record: dict) -> bool:
+    """The push's impulse is above its capture bound (no stepping controller can
+    recover it on the LIPM with the same parameters)."""
+    return bool(record["impulse"] > record["capture_bound"])
+
+
 def _counts(rows: list[dict]) -> dict[str, int]:
     counts = {outcome: sum(r["outcome"] == outcome for r in rows) for outcome in OUTCOMES}
     counts["not_fallen"] = counts["recovered"] + counts["survived"]
     counts["runs"] = len(rows)
+    counts["beyond_bound"] = sum(beyond_bound(r) for r in rows)
     return counts
 
 
@@ -198,7 +218,12 @@ def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float)
                 "survived": "no fall within settle after the push start",
                 "fell": "fell",
             },
-            "units": {"impulse": "N s", "direction_deg": "deg", "phase": "-"},
+            "units": {
+                "impulse": "N s",
+                "direction_deg": "deg",
+                "phase": "-",
+                "capture_bound": "N s",
+            },
             "summary": summarize(spec, records),
             "records": records,
             "wall_time": wall_time,
@@ -207,7 +232,8 @@ def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float)
         json_path.write_text(json.dumps(document, indent=2) + "\n")
         csv_path = out / "grid.csv"
         columns = ["controller", "phase", "direction_deg", "impulse", "outcome", "push_time",
-                   "stance", "end_time", "adjusted_steps", "fall_reason"]  # fmt: skip
+                   "stance", "capture_bound", "end_time", "adjusted_steps",
+                   "fall_reason"]  # fmt: skip
         lines = [",".join(columns)]
         lines += [",".join(str(r[c]).replace(",", ";") for c in columns) for r in records]
         csv_path.write_text("\n".join(lines) + "\n")
@@ -218,10 +244,14 @@ def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float)
 
 def format_grid(spec: GridSpec, records: list[dict]) -> str:
     """Per controller and phase: not fallen (recovered) per impulse, and a row of symbols
-    per impulse over the directions (o recovered, s survived, x fell)."""
+    per impulse over the directions (o recovered, s survived, x fell; in capitals
+    when the impulse is above the push's capture bound)."""
     symbol = {"recovered": "o", "survived": "s", "fell": "x"}
     directions = " ".join(f"{d:g}" for d in spec.directions_deg())
-    lines = [f"outcome per direction ({directions} deg): o recovered, s survived, x fell"]
+    lines = [
+        f"outcome per direction ({directions} deg): o recovered, s survived, x fell; "
+        "capitals: impulse above the LIPM capture bound (no stepping controller recovers it)"
+    ]
     if spec.overrides:
         lines.insert(0, "with " + " ".join(f"--set {n}={v}" for n, v in spec.overrides))
     summary = summarize(spec, records)
@@ -237,10 +267,14 @@ def format_grid(spec: GridSpec, records: list[dict]) -> str:
                     and r["impulse"] == impulse
                 ]  # fmt: skip
                 counts = part["per_impulse"][f"{impulse:g}"]
-                marks = "".join(symbol[r["outcome"]] for r in rows)
+                marks = "".join(
+                    symbol[r["outcome"]].upper() if beyond_bound(r) else symbol[r["outcome"]]
+                    for r in rows
+                )
                 cells.append(f"{impulse:g} N s {counts['not_fallen']}/{counts['runs']} [{marks}]")
+            beyond = f" ({total['beyond_bound']} above the bound)" if total["beyond_bound"] else ""
             lines.append(
                 f"{controller:<13} phase {phase:g}: not fallen {total['not_fallen']}/"
-                f"{total['runs']}, recovered {total['recovered']}; " + "; ".join(cells)
+                f"{total['runs']}{beyond}, recovered {total['recovered']}; " + "; ".join(cells)
             )
     return "\n".join(lines)

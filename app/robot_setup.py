@@ -70,16 +70,18 @@ def planner_config_for(
 
 
 def robot_with_overrides(
-    robot: str | RobotDescription, overrides: Overrides = ()
+    robot: str | RobotDescription, overrides: Overrides = (), model: str = "pybullet"
 ) -> tuple[RobotDescription, ParsedOverrides]:
     """The description of ``robot`` (a registry name or a description) with the
-    description fields and backend options of ``overrides`` (``--set``).
+    description fields and backend options of ``overrides`` (``--set``; on
+    ``model`` ``lipm`` backend options are not allowed).
 
     Raises:
         ParameterError: Unknown robot, or a bad override.
     """
     description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
-    parsed = parse_overrides(overrides, "pybullet")
+    name = robot if isinstance(robot, str) else robot.name
+    parsed = parse_overrides(overrides, model, name)
     return apply_to_description(description, parsed), parsed
 
 
@@ -117,7 +119,7 @@ def build_robot_backend(  # noqa: ANN201
     return backend, config, initial
 
 
-def check_robot_overrides(robot: str, overrides: Overrides) -> None:
+def check_robot_overrides(robot: str | None, overrides: Overrides) -> None:
     """Build ``robot`` once with ``overrides`` (then close it), so that a value out of
     range is reported, as the backend or the planner words it, before a grid or a
     sweep starts its worker processes.
@@ -127,5 +129,5 @@ def check_robot_overrides(robot: str, overrides: Overrides) -> None:
     """
     if not overrides:
         return
-    backend, _, _ = build_robot_backend(robot, "rsg", overrides)
+    backend, _, _ = build_robot_backend(robot or "g1", "rsg", overrides)
     backend.close()

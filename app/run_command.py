@@ -13,6 +13,7 @@ from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
 from .setup import build_backend
+from .sweep import resolve_robot
 
 
 class ProgressBar:
@@ -73,7 +74,7 @@ def run_command(args: argparse.Namespace) -> int:
             )
         from .placo_wpg import build_placo_wpg_backend
 
-        backend, config, initial, planner = build_placo_wpg_backend(args.robot, overrides)
+        backend, config, initial, planner = build_placo_wpg_backend(args.robot or "g1", overrides)
     else:
         backend, config, initial = build_backend(
             args.model, args.robot, args.controller, args.paper_rules, overrides
@@ -96,6 +97,9 @@ def run_command(args: argparse.Namespace) -> int:
             planner=planner,
         )
         result.impulse_scale = factor
+        robot = resolve_robot(args.model, args.robot)
+        if robot is not None:
+            result.extra["robot"] = robot
         if overrides:
             result.extra["overrides"] = dict(overrides)
     finally:

@@ -26,12 +26,19 @@ def paper_rules(config: PlannerConfig) -> PlannerConfig:
 
 
 def build_backend(
-    model: str, robot: str, controller: str, paper: bool = False, overrides: Overrides = ()
+    model: str,
+    robot: str | None,
+    controller: str,
+    paper: bool = False,
+    overrides: Overrides = (),
 ) -> tuple[Backend, PlannerConfig, InitialCondition]:
     """The backend for ``model`` and the planner configuration that fits it.
 
     Args:
-        model, robot, controller: Names as on the command line.
+        model, robot, controller: Names as on the command line. ``robot`` ``None``
+            is G1 on ``pybullet`` and the paper's point mass on ``lipm``; a robot on
+            ``lipm`` is its planner configuration (mass, sole, gait, timing) on the
+            point mass, what the RSG could do if the robot realised the LIPM exactly.
         paper: The paper's rules only (:func:`paper_rules`).
         overrides: ``--set`` pairs (:mod:`app.overrides`); RSG parameters among
             them are applied after ``paper``.
@@ -40,8 +47,14 @@ def build_backend(
         ParameterError: Unknown model or robot, or a bad override.
     """
     if model == "lipm":
-        parsed = parse_overrides(overrides, "lipm")
-        config = PlannerConfig(controller=controller)
+        if robot is None:
+            parsed = parse_overrides(overrides, "lipm")
+            config = PlannerConfig(controller=controller)
+        else:
+            from .robot_setup import planner_config_for, robot_with_overrides
+
+            description, parsed = robot_with_overrides(robot, overrides, "lipm")
+            config = planner_config_for(description, description.total_mass, controller)
         if paper:
             config = paper_rules(config)
         config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
@@ -49,5 +62,5 @@ def build_backend(
     if model == "pybullet":
         from .robot_setup import build_robot_backend
 
-        return build_robot_backend(robot, controller, overrides, paper)
+        return build_robot_backend(robot or "g1", controller, overrides, paper)
     raise ParameterError("--model", model, "lipm or pybullet")

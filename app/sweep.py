@@ -55,7 +55,7 @@ class GridLike(Protocol):
     @property
     def model(self) -> str: ...
     @property
-    def robot(self) -> str: ...
+    def robot(self) -> str | None: ...
     @property
     def paper_rules(self) -> bool: ...
     @property
@@ -73,12 +73,25 @@ RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "
                  "overrides")  # fmt: skip
 
 
+DEFAULT_ROBOT = "g1"
+
+
+def resolve_robot(model: str, robot: str | None) -> str | None:
+    """The robot a run uses: on ``pybullet`` ``robot`` or :data:`DEFAULT_ROBOT`; on
+    ``lipm`` ``robot`` (``None``: the paper's point mass; a name: that robot's
+    planner configuration, mass, sole, gait and timing, on the point mass)."""
+    if model == "pybullet" and robot is None:
+        return DEFAULT_ROBOT
+    return robot
+
+
 def check_pushes(
     model: str,
     controllers: tuple[str, ...],
     directions: int,
     phases: tuple[float, ...],
     overrides: Overrides = (),
+    robot: str | None = None,
 ) -> None:
     """Validate what a sweep and a push grid share.
 
@@ -103,7 +116,11 @@ def check_pushes(
         raise ParameterError("directions", directions, "an integer in [1, 360]")
     if not phases or not all(0.0 <= p < 1.0 for p in phases):
         raise ParameterError("phases", phases, "fractions in [0, 1)")
-    parse_overrides(overrides, model)
+    if robot is not None:
+        from robots import get_robot
+
+        get_robot(robot)
+    parse_overrides(overrides, model, robot)
 
 
 @dataclass(frozen=True)
@@ -112,7 +129,8 @@ class SweepSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: Robot for ``pybullet``.
+        robot: The robot (:func:`resolve_robot`: ``None`` is G1 on ``pybullet`` and
+            the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         directions: Number of push directions, evenly spaced.
         phases: Push phases p in [0, 1) of the walking cycle.
@@ -133,7 +151,7 @@ class SweepSpec:
     """
 
     model: str = "lipm"
-    robot: str = "g1"
+    robot: str | None = None
     controllers: tuple[str, ...] = CONTROLLERS
     directions: int = 16
     phases: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
@@ -149,7 +167,10 @@ class SweepSpec:
     overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        check_pushes(self.model, self.controllers, self.directions, self.phases, self.overrides)
+        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        check_pushes(
+            self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
+        )
         checks = {
             "duration": (self.duration, 1e-3, 1.0),
             "settle": (self.settle, 1.0, 60.0),
@@ -196,7 +217,7 @@ def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN2
     if controller == PLACO_WPG:
         from .placo_wpg import build_placo_wpg_backend
 
-        return build_placo_wpg_backend(spec.robot, spec.overrides)
+        return build_placo_wpg_backend(spec.robot or DEFAULT_ROBOT, spec.overrides)
     return (*_build_rsg(spec, controller), None)
 
 

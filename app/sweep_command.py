@@ -10,7 +10,7 @@ from pathlib import Path
 from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
-from .overrides import add_set_argument
+from .overrides import add_robot_argument, add_set_argument
 from .robot_setup import check_robot_overrides
 from .sweep import PLACO_WPG, SweepSpec, run_sweep
 from .sweep_plot import plot_envelope
@@ -52,7 +52,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--model", choices=("lipm", "pybullet"), default="lipm")
-    p.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    add_robot_argument(p)
     p.add_argument(
         "--controllers",
         type=_csv,

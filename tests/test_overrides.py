@@ -11,7 +11,7 @@ import pytest
 
 from app.cli import main
 from app.overrides import allowed_names, parse_assignment, parse_overrides, parse_value
-from app.push_grid import GridSpec
+from app.push_grid import GridSpec, run_grid
 from app.robot_setup import build_robot_backend, robot_with_overrides
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
@@ -112,7 +112,7 @@ def test_a_later_earliest_step_keeps_steps_apart_on_the_lipm() -> None:
     scenario = Scenario("forward", 6.0, (Push(2.4, np.array([40.0, 0.0]), 0.1),))
 
     def step_intervals(overrides: tuple) -> np.ndarray:
-        backend, config, initial = build_backend("lipm", "g1", "rsg", overrides=overrides)
+        backend, config, initial = build_backend("lipm", None, "rsg", overrides=overrides)
         result = run_closed_loop(backend, config, scenario, initial)
         assert result.recovered
         return np.diff([step.event["t"] for step in result.steps])
@@ -124,10 +124,10 @@ def test_a_later_earliest_step_keeps_steps_apart_on_the_lipm() -> None:
 
 
 def test_paper_rules_then_set(tmp_path: Path) -> None:
-    _, config, _ = build_backend("lipm", "g1", "rsg", paper=True)
+    _, config, _ = build_backend("lipm", None, "rsg", paper=True)
     assert config.rsg.step_reaction_time == 0.0
     _, config, _ = build_backend(
-        "lipm", "g1", "rsg", paper=True, overrides=(("step_reaction_time", "0.1"),)
+        "lipm", None, "rsg", paper=True, overrides=(("step_reaction_time", "0.1"),)
     )
     assert config.rsg.step_reaction_time == 0.1  # --set wins over --paper-rules
 
@@ -179,3 +179,52 @@ def test_an_error_in_a_worker_process_reaches_the_command_with_its_data(tmp_path
     err = capsys.readouterr().err
     assert "step_width=0.2 is not allowed" in err and "2 w_y + mu_2 = 5.140 m" in err
     assert "Traceback" not in err
+
+
+def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
+    """``--model lipm --robot g1``: G1's mass, ZMP window and timing, with its
+    description fields settable and its backend options not."""
+    from robots import get_robot
+
+    g1 = get_robot("g1")
+    backend, config, _ = build_backend(
+        "lipm", "g1", "rsg", overrides=(("swing_preparation_time", "0.3"),)
+    )
+    assert backend.name == "lipm"
+    assert config.model.mass == pytest.approx(g1.total_mass)
+    assert config.model.com_height == pytest.approx(g1.com_height)
+    assert config.rsg.swing_preparation_time == pytest.approx(0.3)
+    assert config.constraints.zmp_window_max[1] < g1.sole.half_width
+    _, paper, _ = build_backend("lipm", None, "rsg")
+    assert paper.model.mass != pytest.approx(g1.total_mass)
+    with pytest.raises(ParameterError) as error:
+        build_backend("lipm", "g1", "rsg", overrides=(("cop_admittance", "0.2"),))
+    assert "swing_preparation_time" in error.value.allowed
+    assert "cop_admittance" not in error.value.allowed
+    assert "swing_preparation_time" in allowed_names("lipm", "g1")
+    assert (
+        "swing_preparation_time"
+        not in parse_overrides((("swing_preparation_time", "0.3"),), "lipm").description
+    )
+
+
+def test_g1_steps_too_late_for_a_push_towards_its_stance_side_at_its_own_t_sp() -> None:
+    """The planner alone (G1's limits, a perfect point mass): 10 N s at mid single
+    support towards the stance side is lost with G1's T_SP = 0.5 s, recovered with
+    0.3 s (the next step can come 0.2 s earlier); forward it is recovered with both."""
+    outcomes = {}
+    for t_sp in ("0.5", "0.3"):
+        spec = GridSpec(
+            model="lipm",
+            robot="g1",
+            controllers=("rsg",),
+            impulses=(10.0,),
+            directions=4,
+            overrides=(("swing_preparation_time", t_sp),),
+        )
+        records = run_grid(spec, workers=1, progress=False)
+        outcomes[t_sp] = {r["direction_deg"]: r["outcome"] for r in records}
+        assert all(r["stance"] == "right" for r in records)
+    assert outcomes["0.5"][0.0] == outcomes["0.3"][0.0] == "recovered"
+    assert outcomes["0.5"][270.0] == "fell"
+    assert outcomes["0.3"][270.0] == "recovered"

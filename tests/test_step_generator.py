@@ -233,7 +233,7 @@ def test_paper_rules_give_the_papers_jump_set_on_fig6():
     from app.runner import run_closed_loop
     from app.setup import build_backend
 
-    _, config, _ = build_backend("lipm", "g1", "rsg", paper=True)
+    _, config, _ = build_backend("lipm", None, "rsg", paper=True)
     assert config.rsg.push_hold_time == 0.0 and config.constraints.com_reach == np.inf
     paper = run_closed_loop(LipmBackend(config.model), config, FIG6, qp_solver="exact")
     default = run_lipm("rsg", FIG6, qp_solver="exact")

@@ -22,7 +22,7 @@ def wait_for(condition, timeout: float = 20.0) -> bool:
 
 def test_push_gives_adjusted_step_and_reset_restarts():
     lines: list[str] = []
-    live = LiveSimulation("lipm", "g1", "rsg", "walk", log=lines.append)
+    live = LiveSimulation("lipm", None, "rsg", "walk", log=lines.append)
     live.start()
     try:
         assert wait_for(lambda: live.snapshot().status.time > 0.3)
@@ -55,7 +55,7 @@ def test_push_gives_adjusted_step_and_reset_restarts():
 
 
 def test_controller_change_and_bad_requests():
-    live = LiveSimulation("lipm", "g1", "rsg", "walk", log=lambda _: None)
+    live = LiveSimulation("lipm", None, "rsg", "walk", log=lambda _: None)
     live.start()
     try:
         live.request_controller("no-step")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 
+from app.overrides import add_robot_argument
 from planner.parameters import CONTROLLERS
 
 DEMO_EPILOG = """\
@@ -58,7 +59,7 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default="pybullet",
         help="pybullet: full robot (URDF meshes); lipm: point mass (default: pybullet)",
     )
-    demo.add_argument("--robot", default="g1", help="robot for --model pybullet (default: g1)")
+    add_robot_argument(demo)
     demo.add_argument(
         "--controller",
         choices=CONTROLLERS,

@@ -32,13 +32,14 @@ def port_is_free(host: str, port: int) -> bool:
     return True
 
 
-def _robot_urdf(model: str, robot: str) -> Path | None:
+def _robot_urdf(model: str, robot: str | None) -> Path | None:
     if model != "pybullet":
         return None
+    from app.sweep import DEFAULT_ROBOT
     from robots import get_robot
     from robots.urdf_cache import derived_urdf
 
-    return derived_urdf(get_robot(robot))
+    return derived_urdf(get_robot(robot or DEFAULT_ROBOT))
 
 
 def _interrupt(signum: int, frame: FrameType | None) -> None:

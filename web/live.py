@@ -25,6 +25,7 @@ from numpy.typing import NDArray
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
 from app.setup import build_backend
+from app.sweep import resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
@@ -152,7 +153,8 @@ class LiveSimulation:
 
     Args:
         model: ``lipm`` or ``pybullet``.
-        robot: Robot name for the PyBullet backend.
+        robot: Robot name (``None``: G1 on ``pybullet``, the paper's point mass on
+            ``lipm``; a robot on ``lipm`` is its planner on the point mass).
         controller: One of :data:`planner.parameters.CONTROLLERS`.
         scenario: Built-in scenario name or TOML path; its pushes are applied too.
         log: Called with each event line (default: print to stdout and flush).
@@ -164,13 +166,13 @@ class LiveSimulation:
     def __init__(
         self,
         model: str = "pybullet",
-        robot: str = "g1",
+        robot: str | None = None,
         controller: str = "rsg",
         scenario: str = "walk",
         log: Callable[[str], None] | None = None,
     ) -> None:
         self.model = model
-        self.robot = robot
+        self.robot = resolve_robot(model, robot)
         self._log = log or _print_line
         self._scenario_source: Scenario = load_scenario(scenario)
         self._requests: queue.Queue[tuple[str, object]] = queue.Queue()
@@ -427,7 +429,7 @@ class LiveSimulation:
         status = LiveStatus(
             time=loop.time,
             model=self.model,
-            robot=self.robot,
+            robot=self.robot or "",
             controller=self._controller,
             paused=self._paused,
             slow_motion=self._slow_motion,
