@@ -93,7 +93,10 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   the planner's ``step_reaction_time`` (0.2 s): the touchdown is scheduled when D_T
   fires and the foothold is the QP at the predicted touchdown state; the swing sole
   follows it with a bounded acceleration (``swing_acceleration``) and does not come
-  down while still far from it (``swing_descent_slope``). Remaining limitation,
+  down while still far from it (``swing_descent_slope``); the bound yields to the
+  landing time (``swing_land_on_time``), else a foothold still moving late in the
+  reaction time left the sole 4-5 cm off and 2 cm up at the step, and the IK slammed
+  it down at ~2 m/s (the robot left the ground for 70 ms). Remaining limitation,
   measured: right after an adjusted step the DCM error jumps by 2-5 cm within
   50 ms (landing impact, bounce, CoP on a sole edge), which G1's +-2 cm lateral
   ZMP window cannot absorb, so a second and third adjusted step follow and large
@@ -168,6 +171,7 @@ class PyBulletBackend:
         landing_clearance: float = 0.0,
         swing_acceleration: float | None = None,
         swing_descent_slope: float = 0.0,
+        swing_land_on_time: bool = False,
         foothold_feedback: bool = False,
         cop_feedback: float | tuple[float, float] = 0.0,
         cop_admittance: float = 0.0,
@@ -232,6 +236,8 @@ class PyBulletBackend:
                 acceleration when its target moves [m/s^2] (None: unbounded).
             swing_descent_slope: The swing sole stays at least this many metres
                 up per metre still to go horizontally [-].
+            swing_land_on_time: The acceleration bound yields to the landing time:
+                the swing sole is above the foothold when the step is due.
             foothold_feedback: At the end of each double support, measure how far
                 the stance sole stands from the planner's foothold and aim the swing
                 foot that much the other way, so landing errors do not add up.
@@ -334,6 +340,7 @@ class PyBulletBackend:
             smooth_horizontal=smooth_swing,
             max_acceleration=swing_acceleration,
             descent_slope=swing_descent_slope,
+            land_on_time=swing_land_on_time,
         )
         if not 0.0 <= landing_delay <= 0.05:
             raise ParameterError("landing_delay", landing_delay, "in [0, 0.05] s")

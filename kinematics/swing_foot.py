@@ -118,6 +118,7 @@ class SwingFootTrajectory:
         smooth_horizontal: bool = False,
         max_acceleration: float | None = None,
         descent_slope: float = 0.0,
+        land_on_time: bool = False,
     ) -> None:
         """Set the parameters.
 
@@ -137,6 +138,9 @@ class SwingFootTrajectory:
             max_acceleration: Bound [m/s^2] on the horizontal acceleration of
                 a re-planned approach (None: only ``min_horizontal_time``).
             descent_slope: Height [m] kept per metre still to go horizontally.
+            land_on_time: The ``max_acceleration`` horizon never reaches past the
+                landing time: the foot is above the target when it lands, at the
+                cost of larger accelerations in its last moments.
         """
         if not 0.0 < apex_height < 0.5:
             raise ParameterError("apex_height", apex_height, "0 < h < 0.5 m")
@@ -163,6 +167,7 @@ class SwingFootTrajectory:
             raise ParameterError("descent_slope", descent_slope, "in [0, 10]")
         self.max_acceleration = max_acceleration
         self.descent_slope = descent_slope
+        self.land_on_time = land_on_time
         self.position = np.zeros(3)
         self.velocity = np.zeros(2)
         self.acceleration = np.zeros(2)
@@ -201,7 +206,10 @@ class SwingFootTrajectory:
             horizon = max(remaining, self.min_horizontal_time, dt)
             if self.max_acceleration is not None:
                 distance = float(np.linalg.norm(target - self.position[:2]))
-                horizon = max(horizon, float(np.sqrt(6.0 * distance / self.max_acceleration)))
+                bounded = float(np.sqrt(6.0 * distance / self.max_acceleration))
+                if self.land_on_time:
+                    bounded = min(bounded, max(landing - (time_since_step - dt), dt))
+                horizon = max(horizon, bounded)
             if self.smooth_horizontal:
                 position, velocity, acceleration = _quintic_step(
                     self.position[:2], self.velocity, self.acceleration, target, horizon, dt

@@ -161,6 +161,28 @@ def test_swing_acceleration_bound_and_descent_funnel():
     assert runs["bounded"][-1, 2] == pytest.approx(0.0, abs=1e-9)
 
 
+def test_a_bounded_swing_can_still_land_on_time():
+    """With the acceleration bound alone a foothold that moves 8 cm 0.15 s before the
+    landing is still centimetres away (and the sole up) when the step is due; with
+    ``land_on_time`` the sole is over it and on the ground then."""
+    landing = 0.5
+    at_landing = {}
+    for land_on_time in (False, True):
+        trajectory = SwingFootTrajectory(
+            TIMING, max_acceleration=20.0, descent_slope=0.5, land_on_time=land_on_time
+        )
+        trajectory.start(np.array([0.0, -0.1]))
+        for k in range(1, round(landing / DT) + 1):
+            time = k * DT
+            target = np.array([0.2, -0.1]) if time < landing - 0.15 else np.array([0.12, 0.0])
+            position = trajectory.update(time, target, DT, landing_time=landing)
+        at_landing[land_on_time] = (np.linalg.norm(position[:2] - [0.12, 0.0]), position[2])
+    distance, height = at_landing[False]
+    assert distance > 0.02 and height > 0.01
+    distance, height = at_landing[True]
+    assert distance < 2e-3 and height == pytest.approx(0.0, abs=2e-3)
+
+
 def test_swing_bounds_are_validated():
     with pytest.raises(ParameterError, match="max_acceleration"):
         SwingFootTrajectory(TIMING, max_acceleration=0.0)
