@@ -18,14 +18,20 @@ COLOURS = {"recovered": "#2a9d3a", "survived": "#f2c14e", "fell": "#c0392b"}
 
 
 def plot_grid(spec: GridSpec, records: list[dict], path: Path) -> Path:
-    """Impulse (rows) x direction (columns) coloured by outcome; returns ``path``."""
-    panels = [(c, p) for c in spec.controllers for p in spec.phases]
+    """Impulse (rows) x direction (columns) coloured by outcome, one panel per
+    controller (columns) and phase (rows); returns ``path``."""
+    rows, columns = len(spec.phases), len(spec.controllers)
     figure, axes = plt.subplots(
-        1, len(panels), figsize=(3.2 * len(panels) + 1.0, 3.4), squeeze=False
+        rows, columns, figsize=(3.4 * columns + 0.6, 3.0 * rows + 0.6), squeeze=False
     )
     directions = spec.directions_deg()
     colormap = ListedColormap([COLOURS[o] for o in OUTCOMES])
-    for axis, (controller, phase) in zip(axes[0], panels, strict=True):
+    panels = [
+        (axes[row, column], controller, phase)
+        for row, phase in enumerate(spec.phases)
+        for column, controller in enumerate(spec.controllers)
+    ]
+    for axis, controller, phase in panels:
         matrix = np.full((len(spec.impulses), len(directions)), np.nan)
         beyond = []
         for record in records:
@@ -37,8 +43,8 @@ def plot_grid(spec: GridSpec, records: list[dict], path: Path) -> Path:
                     beyond.append((column, row))
         axis.imshow(matrix, cmap=colormap, vmin=-0.5, vmax=2.5, origin="lower", aspect="auto")
         if beyond:
-            columns, rows = zip(*beyond, strict=True)
-            axis.plot(columns, rows, "k.", markersize=6)
+            xs, ys = zip(*beyond, strict=True)
+            axis.plot(xs, ys, "k.", markersize=6)
         not_fallen = int(np.sum(matrix < 2))
         axis.set_title(f"{controller}, phase {phase:g}\nnot fallen {not_fallen}/{matrix.size}")
         axis.set_xticks(range(len(directions)), [f"{d:g}" for d in directions], fontsize=7)
@@ -49,7 +55,7 @@ def plot_grid(spec: GridSpec, records: list[dict], path: Path) -> Path:
     handles.append(plt.Line2D([], [], color="k", marker=".", linestyle="none"))
     labels = [*OUTCOMES, "above the LIPM capture bound"]
     figure.legend(handles, labels, loc="lower center", ncol=4, frameon=False)
-    figure.tight_layout(rect=(0.0, 0.08, 1.0, 1.0))
+    figure.tight_layout(rect=(0.0, 0.6 / (3.0 * rows + 0.6), 1.0, 1.0))
     figure.savefig(path, dpi=120)
     plt.close(figure)
     return path
