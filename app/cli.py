@@ -124,6 +124,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_set_argument(run)
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    run.add_argument(
+        "--physics-log",
+        action="store_true",
+        help="also write physics.csv: CoM, foot forces and CoPs, soles at every 1 ms "
+        "physics step (--model pybullet; touchdowns and impacts)",
+    )
     run.add_argument("--quiet", action="store_true", help="no progress bar")
     for command in plugin_commands().values():
         command.add_parser(sub)

@@ -116,6 +116,7 @@ from scipy.spatial.transform import Rotation
 from app.backend import FallStatus, InitialCondition
 from app.pybullet_ankle import MIN_LOAD_FRACTION, AnkleCopFeedback
 from app.pybullet_com_plan import cop_admittance_zmp, momentum_aware_pivot
+from app.physics_log import PhysicsLog
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import GRAVITY, PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
@@ -313,6 +314,8 @@ class PyBulletBackend:
             raise ParameterError("stance_switch", stance_switch, "planned or contact")
         self.stance_switch = stance_switch
         self._last_command: PlannerOutput | None = None
+        #: Set to a :class:`app.physics_log.PhysicsLog` to record every physics step.
+        self.physics_log: PhysicsLog | None = None
         self._plan_cop = np.zeros(2)  # CoP of the CoM plan over the last tick [m]
         self._pressure: dict[str, tuple[NDArray[np.float64], float]] = {}
         if not 0.0 <= landing_clearance <= 0.01:
@@ -523,6 +526,8 @@ class PyBulletBackend:
                 fraction = substep / self._substeps if self.interpolate_targets else 1.0
                 self.sim.set_joint_targets(previous + fraction * change, velocity)
             self.sim.step(force)
+            if self.physics_log is not None:
+                self.physics_log.record(self.sim, force)
 
     def _settle(self, time_since_step: float) -> float:
         """Height [m] of the new stance sole target: ``landing_clearance`` ramped to 0."""

@@ -79,6 +79,16 @@ def run_command(args: argparse.Namespace) -> int:
         backend, config, initial = build_backend(
             args.model, args.robot, args.controller, args.paper_rules, overrides
         )
+    physics_log = None
+    if args.physics_log:
+        if not hasattr(backend, "physics_log"):
+            backend.close()
+            raise ParameterError(
+                "--model", args.model, "pybullet with --physics-log (the LIPM has no physics steps)"
+            )
+        from .physics_log import PhysicsLog
+
+        physics_log = backend.physics_log = PhysicsLog()
     if overrides:
         print("with " + " ".join(f"--set {name}={value}" for name, value in overrides))
     try:
@@ -108,6 +118,8 @@ def run_command(args: argparse.Namespace) -> int:
     summary = write_results(result, args.controller, out, plots=not args.no_plots)
     for name in ("summary.json", "timeseries.csv"):
         print(f"wrote {out / name}")
+    if physics_log is not None:
+        print(f"wrote {physics_log.write(out / 'physics.csv')}")
     if not args.no_plots:
         print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
     print(verdict(result))

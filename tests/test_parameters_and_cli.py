@@ -179,3 +179,11 @@ def test_project_errors_keep_their_data_across_processes(error):
     copy = pickle.loads(pickle.dumps(error))
     assert type(copy) is type(error) and str(copy) == str(error)
     assert {k: str(v) for k, v in vars(copy).items()} == {k: str(v) for k, v in vars(error).items()}
+
+
+def test_the_physics_log_needs_the_full_robot(tmp_path, capsys) -> None:
+    code = main(["run", "--model", "lipm", "--physics-log", "--out", str(tmp_path), "--quiet"])
+    assert code == 2
+    error = capsys.readouterr().err
+    assert "--model" in error and "pybullet" in error and "Traceback" not in error
+    assert not (tmp_path / "physics.csv").exists()

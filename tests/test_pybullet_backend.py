@@ -312,3 +312,34 @@ def test_a_touchdown_is_reported_only_when_the_stance_switches_at_contact(switch
     for time, position in touchdowns:
         assert 0.8 - CONTACT_WINDOW <= time < 0.8
         np.testing.assert_allclose(position, RIGHT.position, atol=0.01)
+
+
+def test_the_physics_log_records_every_step_consistently(backend, tmp_path):
+    """Standing, then pushed: one row per 1 ms step; the feet carry the weight on
+    average (vertical equilibrium); the CoM velocity is the derivative of the CoM;
+    the push is logged while it acts and its impulse is the one applied."""
+    from app.physics_log import COLUMNS, PhysicsLog
+
+    backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+    backend.physics_log = PhysicsLog()
+
+    def push(time):
+        return np.array([20.0, 0.0]) if 0.5 <= time < 0.6 else np.zeros(2)
+
+    stand(backend, 1.0, push)
+    path = backend.physics_log.write(tmp_path / "physics.csv")
+    header, *lines = path.read_text().splitlines()
+    assert tuple(header.split(",")) == COLUMNS
+    rows = np.array([[float(v) for v in line.split(",")] for line in lines])
+    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    assert len(rows) == 1000
+    assert np.allclose(np.diff(column["t"]), 1e-3)
+    quiet = column["t"] < 0.5
+    weight = backend.mass * 9.81
+    support = column["left_fz"][quiet] + column["right_fz"][quiet]
+    assert support.mean() == pytest.approx(weight, rel=0.02)
+    derivative = np.gradient(column["com_x"], column["t"])
+    assert np.abs(derivative[5:-5] - column["com_vx"][5:-5]).max() < 0.02
+    impulse = column["push_fx"].sum() * 1e-3
+    assert impulse == pytest.approx(2.0, rel=1e-6)
+    assert np.all(column["left_sole_z"] > -0.005)
