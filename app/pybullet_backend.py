@@ -114,9 +114,9 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from app.backend import FallStatus, InitialCondition
+from app.physics_log import PhysicsLog
 from app.pybullet_ankle import MIN_LOAD_FRACTION, AnkleCopFeedback
 from app.pybullet_com_plan import cop_admittance_zmp, momentum_aware_pivot
-from app.physics_log import PhysicsLog
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import GRAVITY, PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
