@@ -4,9 +4,10 @@ The walk and paper-fig6 tests state the goal of the full-robot backend. They are
 marked ``xfail(strict=True)`` while the goal is not met, so that they start to
 fail (and the marker must go) as soon as it is. Status, measured with the G1
 defaults of ``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted,
-max V_u 0.64 gamma_v); paper-fig6 still falls at 5.3 s (after the first adjusted
-step the DCM error is back above the lateral ZMP window within 50 ms); see
-``app/pybullet_backend.py``.
+max V_u 0.64 gamma_v); paper-fig6 still falls at 5.1 s (its first adjusted step
+touches down 40 ms early with a 4.4 kN spike, the robot leaves the ground, and the
+lateral DCM error grows beyond the ZMP window before the next step may land); see
+``app/pybullet_backend.py`` and ``rsg run --physics-log``.
 """
 
 from __future__ import annotations
