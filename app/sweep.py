@@ -337,11 +337,12 @@ def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
         # Tuples as JSON lists, as stored.
         new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, SweepSpec()))
         for name in RESULT_FIELDS:  # a field missing from an older spec had its default
-            if old.get(name, defaults[name]) != new[name]:
+            stored = old.get(name, defaults[name])
+            if stored != new[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",
-                    old.get(name),
-                    f"the same {name} as the sweep stored there ({asdict(spec)[name]!r}), "
+                    asdict(spec)[name],
+                    f"the same {name} as the sweep stored there ({stored!r}), "
                     "or a new --out folder",
                 )
     finished: dict[str, dict] = {}

@@ -164,6 +164,8 @@ def test_a_resumed_sweep_must_have_the_same_overrides(tmp_path: Path) -> None:
     with pytest.raises(ParameterError) as error:
         run_sweep(other, tmp_path, workers=1, progress=False)
     assert "overrides" in error.value.field
+    assert error.value.value == (("crossing_margin", "0.04"),)  # what was given
+    assert "0.05" in error.value.allowed  # what the folder holds
 
 
 def test_an_error_in_a_worker_process_reaches_the_command_with_its_data(tmp_path: Path, capsys):
