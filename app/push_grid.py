@@ -36,7 +36,8 @@ from planner.types import Push
 from .capturability import impulse_bound
 from .overrides import Overrides
 from .scenarios import Scenario
-from .sweep import JobProgress, build_controller, check_pushes, resolve_robot, run_in_processes
+from .setup import resolve_robot
+from .sweep import JobProgress, build_controller, check_pushes, run_in_processes
 from .sweep_trial import push_timing
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -48,7 +49,7 @@ class GridSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.sweep.resolve_robot`: ``None`` is G1 on
+        robot: The robot (:func:`app.setup.resolve_robot`: ``None`` is G1 on
             ``pybullet`` and the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         impulses: Push impulses [N s].

@@ -24,6 +24,7 @@ from .overrides import (
     parse_overrides,
 )
 from .runner import walking_start
+from .setup import DEFAULT_ROBOT
 
 ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the sole's edges
 
@@ -129,5 +130,5 @@ def check_robot_overrides(robot: str | None, overrides: Overrides) -> None:
     """
     if not overrides:
         return
-    backend, _, _ = build_robot_backend(robot or "g1", "rsg", overrides)
+    backend, _, _ = build_robot_backend(robot or DEFAULT_ROBOT, "rsg", overrides)
     backend.close()

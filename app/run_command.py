@@ -12,8 +12,7 @@ from planner.parameters import CONTROLLERS
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
-from .setup import build_backend
-from .sweep import resolve_robot
+from .setup import DEFAULT_ROBOT, build_backend, resolve_robot
 
 
 class ProgressBar:
@@ -64,6 +63,7 @@ def run_command(args: argparse.Namespace) -> int:
         )
     planner = None
     overrides = tuple(args.overrides)
+    robot = resolve_robot(args.model, args.robot)
     if args.controller == "placo-wpg":
         if args.model != "pybullet":
             raise ParameterError(
@@ -74,10 +74,12 @@ def run_command(args: argparse.Namespace) -> int:
             )
         from .placo_wpg import build_placo_wpg_backend
 
-        backend, config, initial, planner = build_placo_wpg_backend(args.robot or "g1", overrides)
+        backend, config, initial, planner = build_placo_wpg_backend(
+            robot or DEFAULT_ROBOT, overrides
+        )
     else:
         backend, config, initial = build_backend(
-            args.model, args.robot, args.controller, args.paper_rules, overrides
+            args.model, robot, args.controller, args.paper_rules, overrides
         )
     physics_log = None
     if args.physics_log:
@@ -107,7 +109,6 @@ def run_command(args: argparse.Namespace) -> int:
             planner=planner,
         )
         result.impulse_scale = factor
-        robot = resolve_robot(args.model, args.robot)
         if robot is not None:
             result.extra["robot"] = robot
         if overrides:

@@ -13,6 +13,17 @@ from .lipm_backend import LipmBackend
 from .overrides import Overrides, apply_to_rsg, parse_overrides
 from .runner import walking_start
 
+DEFAULT_ROBOT = "g1"
+
+
+def resolve_robot(model: str, robot: str | None) -> str | None:
+    """The robot a run uses: on ``pybullet`` ``robot`` or :data:`DEFAULT_ROBOT`; on
+    ``lipm`` ``robot`` (``None``: the paper's point mass; a name: that robot's
+    planner configuration, mass, sole, gait and timing, on the point mass)."""
+    if model == "pybullet" and robot is None:
+        return DEFAULT_ROBOT
+    return robot
+
 
 def paper_rules(config: PlannerConfig) -> PlannerConfig:
     """``config`` without the documented extensions: the paper's D_T and (27) as printed
@@ -62,5 +73,5 @@ def build_backend(
     if model == "pybullet":
         from .robot_setup import build_robot_backend
 
-        return build_robot_backend(robot or "g1", controller, overrides, paper)
+        return build_robot_backend(robot or DEFAULT_ROBOT, controller, overrides, paper)
     raise ParameterError("--model", model, "lipm or pybullet")

@@ -42,6 +42,7 @@ from .bisection import bisect_threshold
 from .capturability import impulse_bound
 from .overrides import Overrides, parse_overrides
 from .scenarios import Scenario
+from .setup import DEFAULT_ROBOT, resolve_robot
 from .sweep_trial import SettledTrial, push_timing
 
 PLACO_WPG = "placo-wpg"
@@ -71,18 +72,6 @@ SPEC_FILE = "sweep_spec.json"
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
                  "overrides")  # fmt: skip
-
-
-DEFAULT_ROBOT = "g1"
-
-
-def resolve_robot(model: str, robot: str | None) -> str | None:
-    """The robot a run uses: on ``pybullet`` ``robot`` or :data:`DEFAULT_ROBOT`; on
-    ``lipm`` ``robot`` (``None``: the paper's point mass; a name: that robot's
-    planner configuration, mass, sole, gait and timing, on the point mass)."""
-    if model == "pybullet" and robot is None:
-        return DEFAULT_ROBOT
-    return robot
 
 
 def check_pushes(
@@ -129,7 +118,7 @@ class SweepSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`resolve_robot`: ``None`` is G1 on ``pybullet`` and
+        robot: The robot (:func:`app.setup.resolve_robot`: ``None`` is G1 on ``pybullet`` and
             the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         directions: Number of push directions, evenly spaced.

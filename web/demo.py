@@ -35,7 +35,7 @@ def port_is_free(host: str, port: int) -> bool:
 def _robot_urdf(model: str, robot: str | None) -> Path | None:
     if model != "pybullet":
         return None
-    from app.sweep import DEFAULT_ROBOT
+    from app.setup import DEFAULT_ROBOT
     from robots import get_robot
     from robots.urdf_cache import derived_urdf
 

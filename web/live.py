@@ -24,8 +24,7 @@ from numpy.typing import NDArray
 
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
-from app.setup import build_backend
-from app.sweep import resolve_robot
+from app.setup import build_backend, resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
