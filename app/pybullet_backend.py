@@ -120,6 +120,7 @@ from app.pybullet_com_plan import cop_admittance_zmp, momentum_aware_pivot
 from app.pybullet_landing import LandingCorrection
 from app.pybullet_robot import GRAVITY, PHYSICS_TIME_STEP, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
+from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
 from planner.hybrid_lipm import integrate_lipm
@@ -177,6 +178,9 @@ class PyBulletBackend:
         cop_feedback: float | tuple[float, float] = 0.0,
         cop_admittance: float = 0.0,
         stance_switch: str = "planned",
+        upper_body_momentum: float = 0.0,
+        upper_body_return_time: float = 0.5,
+        upper_body_cancel: float = 0.0,
     ) -> None:
         """Load the robot.
 
@@ -254,6 +258,15 @@ class PyBulletBackend:
                 :data:`CONTACT_WINDOW` of the planned step, the measured state then
                 reports the sole's position as ``touchdown`` and the planner jumps
                 onto it at once.
+            upper_body_momentum: h_max [N m s]: the torso and the arms carry the
+                band-passed part of the planner's feedback hdot, up to this much
+                angular momentum (:class:`kinematics.upper_body.UpperBodyFlywheel`
+                on the description's ``upper_body_joints``); 0: off, all of hdot
+                is realised by the CoP as a CMP shift of the CoM plan.
+            upper_body_return_time: T_r of that band-pass, and the time constant
+                of the upper body's return to its posture [s].
+            upper_body_cancel: Fraction [0, 1] of the high-passed angular momentum
+                of the IK motion (the legs' swing) the upper body takes back.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -313,6 +326,18 @@ class PyBulletBackend:
         if stance_switch not in ("planned", "contact"):
             raise ParameterError("stance_switch", stance_switch, "planned or contact")
         self.stance_switch = stance_switch
+        if not 0.0 <= upper_body_momentum <= 10.0:
+            raise ParameterError("upper_body_momentum", upper_body_momentum, "in [0, 10] N m s")
+        if not 0.0 < upper_body_return_time <= 10.0:
+            raise ParameterError("upper_body_return_time", upper_body_return_time, "in (0, 10] s")
+        if upper_body_momentum > 0.0 and not self.description.upper_body_joints:
+            raise ParameterError(
+                "upper_body_momentum",
+                upper_body_momentum,
+                f"0 for {self.description.name}, whose description lists no upper_body_joints",
+            )
+        self.upper_body_momentum = upper_body_momentum
+        self.upper_body_return_time = upper_body_return_time
         self._last_command: PlannerOutput | None = None
         #: Set to a :class:`app.physics_log.PhysicsLog` to record every physics step.
         self.physics_log: PhysicsLog | None = None
@@ -325,13 +350,26 @@ class PyBulletBackend:
         self._com_velocity_reference = np.zeros(2)
         self.timing = timing or SwingTiming()
         self.sim = SimulatedRobot(self.description)
-        self.ik = WholeBodyIK(self.description, use_angular_momentum=use_angular_momentum)
+        self.ik = WholeBodyIK(
+            self.description,
+            use_angular_momentum=use_angular_momentum,
+            upper_body=upper_body_momentum > 0.0,
+        )
         self._ik_to_sim = [self.ik.joint_names.index(name) for name in self.sim.joint_names]
         self._ankle_joints = {foot: self._ankle_joint_names(foot) for foot in ("left", "right")}
         self._ankle_sim_index = {
             foot: [self.sim.joint_names.index(name) for name in names]
             for foot, names in self._ankle_joints.items()
         }
+        self.flywheel: UpperBodyFlywheel | None = None
+        if upper_body_momentum > 0.0:
+            self.flywheel = UpperBodyFlywheel(
+                self.ik.robot,
+                self.ik.upper_body_joints,
+                return_time=upper_body_return_time,
+                max_momentum=upper_body_momentum,
+                cancel=upper_body_cancel,
+            )
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
         self._lipm = LipmModel(mass=self.mass, com_height=self.com_height)
@@ -407,6 +445,8 @@ class PyBulletBackend:
         self._ik_failure = None
         self._stance_offset = np.zeros(2)
         self.ankle.reset()
+        if self.flywheel is not None:
+            self.flywheel.reset()
         self._plan_cop = np.asarray(initial.com_position, float).copy()
         return self._measured
 
@@ -470,8 +510,11 @@ class PyBulletBackend:
 
         support = "both" if command.double_support else stance
         planned = clock.perf_counter()
+        offsets = self._upper_body_offsets(command)
         try:
-            q = self.ik.solve(com_target, soles["left"], soles["right"], support, dt)
+            q = self.ik.solve(
+                com_target, soles["left"], soles["right"], support, dt, upper_body_offsets=offsets
+            )
             q = q[self._ik_to_sim]
         except IkInfeasibleError as error:
             # Measured only while falling (feet and CoM far apart): hold the last
@@ -597,6 +640,21 @@ class PyBulletBackend:
             self.description.sole,
             self.cop_margin,
             ramped_double_support=self.plan_angular_momentum != "full",
+        )
+
+    def _upper_body_offsets(self, command: PlannerOutput) -> NDArray[np.float64] | None:
+        """Upper-body joint offsets [rad] that carry the planner's hdot (None: off).
+
+        The rest of the motion is the IK's last motion less the upper body's part.
+        """
+        if self.flywheel is None:
+            return None
+        rest = self.ik.angular_momentum[:2] - self.flywheel.momentum
+        return self.flywheel.follow_rate(
+            command.angular_momentum_rate_feedback,
+            self.ik.upper_body_posture,
+            self.control_period,
+            rest,
         )
 
     def _ankle_joint_names(self, foot: str) -> list[str]:

@@ -8,8 +8,12 @@ of the simulation and moves it, once per control tick, so that:
 * the CoM follows the target [m] (soft, high weight);
 * the trunk and the pelvis stay upright with the feet's mean yaw (soft);
 * the joints stay near the standing posture (soft, low weight), within limits;
-* optionally, the centroidal angular momentum follows a target [N m s] (soft),
-  so the upper body realises the planner's rate of change of angular momentum.
+* optionally, the centroidal angular momentum follows a target [N m s] (soft);
+* optionally (``upper_body=True``), the description's ``upper_body_joints`` follow
+  their standing angles plus offsets given at each solve (soft, the trunk's
+  weight, in place of the trunk orientation task): the upper body turns as a
+  flywheel (:mod:`kinematics.upper_body`) while the CoM task keeps the CoM where
+  the plan wants it.
 
 Its output is the joint target vector for the simulator's position control.
 After each solve, :attr:`WholeBodyIK.angular_momentum` holds the centroidal
@@ -100,13 +104,21 @@ class WholeBodyIK:
             motion of the last :meth:`solve` (finite difference over its ``dt``).
     """
 
-    def __init__(self, description: RobotDescription, use_angular_momentum: bool = False) -> None:
+    def __init__(
+        self,
+        description: RobotDescription,
+        use_angular_momentum: bool = False,
+        upper_body: bool = False,
+    ) -> None:
         """Build the model and the tasks.
 
         Args:
             description: The robot.
             use_angular_momentum: Add the centroidal angular momentum task fed by
                 :meth:`solve`'s ``angular_momentum`` argument.
+            upper_body: Replace the trunk orientation task by a joint task on the
+                description's ``upper_body_joints``, fed by :meth:`solve`'s
+                ``upper_body_offsets``.
         """
         self.description = description
         self.robot = placo.HumanoidRobot(
@@ -127,13 +139,26 @@ class WholeBodyIK:
         }
         self.com_task = self.solver.add_com_task(np.zeros(3))
         self.com_task.configure("com", "soft", COM_WEIGHT)
-        self.trunk_task = self.solver.add_orientation_task(TRUNK_FRAME, np.eye(3))
-        self.trunk_task.configure("trunk", "soft", TRUNK_WEIGHT)
+        self.upper_body_joints = list(description.upper_body_joints) if upper_body else []
+        if upper_body and not self.upper_body_joints:
+            raise ParameterError(
+                "upper_body_joints", [], f"at least one joint in {description.name}'s description"
+            )
+        self.trunk_task = None
+        self.upper_body_task = None
+        if self.upper_body_joints:
+            self.upper_body_task = self.solver.add_joints_task()
+            self.upper_body_task.configure("upper_body", "soft", TRUNK_WEIGHT)
+        else:
+            self.trunk_task = self.solver.add_orientation_task(TRUNK_FRAME, np.eye(3))
+            self.trunk_task.configure("trunk", "soft", TRUNK_WEIGHT)
         self.pelvis_task = self.solver.add_orientation_task(description.base_link, np.eye(3))
         self.pelvis_task.configure("pelvis", "soft", TRUNK_WEIGHT)
         self.posture_task = self.solver.add_joints_task()
         self.posture_task.set_joints(self.standing_posture())
         self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
+        standing = self.standing_posture()
+        self.upper_body_posture = np.array([standing[name] for name in self.upper_body_joints])
         self.momentum_task = None
         if use_angular_momentum:
             self.momentum_task = self.solver.add_centroidal_momentum_task(np.zeros(3))
@@ -198,6 +223,7 @@ class WholeBodyIK:
         left_sole: NDArray[np.float64],
         right_sole: NDArray[np.float64],
         angular_momentum: NDArray[np.float64] | None,
+        upper_body_offsets: NDArray[np.float64] | None = None,
     ) -> None:
         self.foot_tasks["left"].T_world_frame = left_sole
         self.foot_tasks["right"].T_world_frame = right_sole
@@ -205,7 +231,13 @@ class WholeBodyIK:
             [com_xy[0], com_xy[1], self.com_z_target(left_sole, right_sole)]
         )
         yaw = _mean_yaw(left_sole, right_sole)
-        self.trunk_task.R_world_frame = yaw_rotation(yaw)
+        if self.trunk_task is not None:
+            self.trunk_task.R_world_frame = yaw_rotation(yaw)
+        if self.upper_body_task is not None:
+            angles = self.upper_body_posture
+            if upper_body_offsets is not None:
+                angles = angles + np.asarray(upper_body_offsets, float)
+            self.upper_body_task.set_joints(dict(zip(self.upper_body_joints, angles, strict=True)))
         self.pelvis_task.R_world_frame = yaw_rotation(yaw)
         if self.momentum_task is not None:
             target = np.zeros(3) if angular_momentum is None else angular_momentum
@@ -225,6 +257,7 @@ class WholeBodyIK:
         support: Support,
         dt: float,
         angular_momentum: NDArray[np.float64] | None = None,
+        upper_body_offsets: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
         """One IK step toward the targets.
 
@@ -236,6 +269,8 @@ class WholeBodyIK:
             dt: Time since the previous solve [s] (for the momentum task).
             angular_momentum: Centroidal angular momentum target [N m s], shape (2,)
                 or (3,), used when the momentum task is enabled.
+            upper_body_offsets: Offsets [rad] of :attr:`upper_body_joints` from
+                their standing angles, used when ``upper_body`` is enabled.
 
         Returns:
             Joint angles [rad] in :attr:`joint_names` order.
@@ -248,7 +283,7 @@ class WholeBodyIK:
             raise ParameterError("support", support, "'left', 'right' or 'both'")
         self._configure_support(support)
         self.solver.dt = dt
-        self._set_targets(com_xy, left_sole, right_sole, angular_momentum)
+        self._set_targets(com_xy, left_sole, right_sole, angular_momentum, upper_body_offsets)
         previous = np.array(self.robot.state.q, dtype=float)
         try:
             self.solver.solve(True)

@@ -106,6 +106,8 @@ class RobotDescription:
             (``RsgParameters.step_reaction_time``).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
+        upper_body_joints: Joints that turn the torso and the arms, used to carry
+            the planner's angular momentum (backend option ``upper_body_momentum``).
         backend_options: Keyword arguments of the PyBullet backend tuned for
             this robot (CoM tracking), see :class:`app.pybullet_backend.PyBulletBackend`.
     """
@@ -140,6 +142,7 @@ class RobotDescription:
     filter_time_constant: float = 0.05
     step_reaction_time: float = 0.0
     sole_box_collision: bool = False
+    upper_body_joints: tuple[str, ...] = ()
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

@@ -1,0 +1,173 @@
+"""The upper body as a bounded flywheel carrying the planner's hdot."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pinocchio
+import pytest
+
+from app.backend import InitialCondition
+from app.pybullet_backend import PyBulletBackend
+from kinematics.upper_body import UpperBodyFlywheel
+from kinematics.whole_body_ik import WholeBodyIK, sole_pose
+from planner.exceptions import ParameterError
+from planner.types import Foothold, PlannerOutput
+from robots import get_robot
+
+DT = 0.01
+G1 = get_robot("g1")
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+@pytest.fixture(scope="module")
+def ik():
+    model = WholeBodyIK(G1)
+    model.reset(sole_pose([0.0, 0.115, 0.0]), sole_pose([0.0, -0.115, 0.0]), np.zeros(2))
+    return model
+
+
+def posture(joints):
+    standing = G1.standing_posture
+    return np.array([standing.get(name, 0.0) for name in joints])
+
+
+def centroidal_angular_momentum(ik, joints, joint_velocity):
+    """Pinocchio's centroidal angular momentum for the given joint velocities [N m s]."""
+    model = ik.robot.model
+    data = model.createData()
+    v = np.zeros(model.nv)
+    for name, rate in zip(joints, joint_velocity, strict=True):
+        v[model.joints[model.getJointId(name)].idx_v] = rate
+    q = np.asarray(ik.robot.state.q, float)
+    return np.asarray(pinocchio.computeCentroidalMomentum(model, data, q, v).angular)
+
+
+def test_the_offsets_carry_the_target_angular_momentum(ik):
+    joints = list(G1.upper_body_joints)
+    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=100.0)
+    target = np.array([0.15, -0.2])  # [N m s]
+    before = flywheel.offsets.copy()
+    flywheel.update(target, posture(joints), DT)
+    joint_velocity = (flywheel.offsets - before) / DT
+    realised = centroidal_angular_momentum(ik, joints, joint_velocity)
+    np.testing.assert_allclose(realised[:2], target, atol=0.01 * np.linalg.norm(target))
+    np.testing.assert_allclose(flywheel.momentum, realised[:2], atol=1e-9)
+    # Mostly the waist: it has the inertia (about 1 kg m^2 against 0.07 for an arm).
+    waist = [joints.index("waist_roll_joint"), joints.index("waist_pitch_joint")]
+    assert np.abs(joint_velocity[waist]).min() > 5 * np.abs(np.delete(joint_velocity, waist)).max()
+
+
+def test_the_offsets_stay_within_their_range_and_then_carry_nothing(ik):
+    joints = list(G1.upper_body_joints)
+    flywheel = UpperBodyFlywheel(ik.robot, joints, max_offset=0.3, return_time=100.0)
+    stand = posture(joints)
+    model = ik.robot.model
+    q_index = [model.joints[model.getJointId(name)].idx_q for name in joints]
+    lower = np.asarray(model.lowerPositionLimit)[q_index]
+    upper = np.asarray(model.upperPositionLimit)[q_index]
+    for _ in range(300):  # 1 N m s held for 3 s: the waist would turn ~3 rad
+        flywheel.update(np.array([1.0, 1.0]), stand, DT)
+        assert np.all(np.abs(flywheel.offsets) <= 0.3 + 1e-12)
+        assert np.all(stand + flywheel.offsets >= lower - 1e-12)
+        assert np.all(stand + flywheel.offsets <= upper + 1e-12)
+    assert np.linalg.norm(flywheel.momentum) < 0.05  # saturated: no more momentum
+
+
+def test_a_steady_rate_is_left_to_the_cop_and_a_pulse_is_carried_then_returned(ik):
+    joints = list(G1.upper_body_joints)
+    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=0.5, max_momentum=1.0)
+    stand = posture(joints)
+    for _ in range(500):  # 5 s of a steady 0.3 N m about x
+        flywheel.follow_rate(np.array([0.3, 0.0]), stand, DT)
+    assert abs(flywheel.target[0]) < 1e-3
+    assert np.all(np.abs(flywheel.offsets) < 0.01)
+    flywheel.reset()
+    peak = 0.0
+    for _ in range(20):  # 3 N m about y for 0.2 s (a saturated feedback after a push)
+        flywheel.follow_rate(np.array([0.0, 3.0]), stand, DT)
+        peak = max(peak, flywheel.target[1])
+    assert 0.3 < peak <= 1.0  # about 3 N m x 0.2 s, less the band-pass
+    pitch = flywheel.offsets[joints.index("waist_pitch_joint")]
+    assert pitch != 0.0
+    for _ in range(500):  # no more hdot: the upper body returns to its posture
+        flywheel.follow_rate(np.zeros(2), stand, DT)
+    assert abs(flywheel.target[1]) < 0.01
+    assert np.all(np.abs(flywheel.offsets) < 0.1 * abs(pitch))
+
+
+def test_the_upper_body_takes_back_part_of_the_legs_swinging_momentum(ik):
+    """A 1.25 Hz oscillation of the rest of the motion's momentum (the legs' swing) is
+    carried back by the upper body at the fraction ``cancel``; its mean is not."""
+    joints = list(G1.upper_body_joints)
+    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=0.5, max_momentum=2.0, cancel=0.5)
+    stand = posture(joints)
+    carried, legs = [], []
+    for tick in range(560):
+        time = tick * DT
+        motion = np.array([0.2 + 0.4 * np.sin(2 * np.pi * 1.25 * time), 0.0])  # [N m s]
+        flywheel.follow_rate(np.zeros(2), stand, DT, motion)
+        carried.append(flywheel.momentum[0])
+        legs.append(motion[0] - 0.2)
+    carried, legs = np.array(carried[240:]), np.array(legs[240:])  # 4 periods
+    gain = -(carried @ legs) / (legs @ legs)  # least-squares fit carried = -gain legs
+    assert 0.35 < gain < 0.55  # 0.5, less the high-pass at 1.25 Hz
+    assert abs(carried.mean()) < 0.02  # the steady 0.2 N m s stays with the legs
+    assert np.all(np.abs(flywheel.offsets) <= flywheel.max_offset)
+
+
+def test_the_flywheel_checks_its_parameters(ik):
+    with pytest.raises(ParameterError, match="upper_body_joints"):
+        UpperBodyFlywheel(ik.robot, ["no_such_joint"])
+    with pytest.raises(ParameterError, match="max_offset"):
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], max_offset=2.0)
+    with pytest.raises(ParameterError, match="max_momentum"):
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], max_momentum=0.0)
+    with pytest.raises(ParameterError, match="cancel"):
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], cancel=1.5)
+
+
+def test_a_robot_without_upper_body_joints_cannot_carry_momentum():
+    talos = dataclasses.replace(get_robot("talos"), upper_body_joints=())
+    with pytest.raises(ParameterError, match="upper_body_momentum.*upper_body_joints"):
+        PyBulletBackend(talos, upper_body_momentum=1.0)
+
+
+def test_in_pybullet_the_waist_turns_with_a_pulse_of_hdot_and_comes_back():
+    """The planner's feedback hdot (3 N m about y for 0.2 s) turns G1's waist, which
+    then returns; the plan itself has no hdot, so only the upper body carries it."""
+    left = Foothold("left", np.array([0.0, 0.115]))
+    right = Foothold("right", np.array([0.0, -0.115]))
+    backend = PyBulletBackend("g1", upper_body_momentum=1.0, upper_body_return_time=0.5)
+    try:
+        backend.reset(InitialCondition(left, right, np.zeros(2), np.zeros(2)))
+        pitches, coms = [], []
+        for tick in range(300):
+            time = tick * backend.control_period
+            rate = np.array([0.0, 3.0]) if 0.5 <= time < 0.7 else np.zeros(2)
+            command = PlannerOutput(
+                time=time, zmp=np.zeros(2), zmp_offset=np.zeros(2), window_center=np.zeros(2),
+                angular_momentum_rate=np.zeros(2), angular_momentum_rate_feedback=rate,
+                stance=left, previous_stance=right, next_step=right, next_step_time=time + 0.8,
+                time_since_step=0.0, double_support=True, dcm_error=np.zeros(2), lyapunov=0.0,
+                lyapunov_at_step=0.0, com_reference=np.zeros(2), step=None,
+            )  # fmt: skip
+            state = backend.step(command, np.zeros(2))
+            pitches.append(backend.sim.joint_angles()["waist_pitch_joint"])  # stands at 0
+            coms.append(state.com_position)
+        assert not backend.fall_status().fell
+    finally:
+        backend.close()
+    pitches = np.array(pitches)
+    quiet = np.abs(pitches[:50]).max()
+    turned = pitches[50:90]
+    # The same sign as the offsets that carry +y momentum (waist pitch column of A > 0).
+    assert turned.max() > 0.03 and turned.max() > 10 * quiet
+    assert abs(pitches[-1]) < 0.5 * turned.max()  # returning (with an undershoot)
+    # The CoP plan accounts for the waist's Ldot: the CoM stays over the feet.
+    assert np.abs(np.array(coms)).max() < 0.01
