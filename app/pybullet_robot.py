@@ -195,10 +195,19 @@ class SimulatedRobot:
         """URDF name of PyBullet link index ``link`` (-1: the base)."""
         return self._link_names.get(link, str(link))
 
-    def sole_position(self, foot: str) -> NDArray[np.float64]:
-        """World position [m] of the sole frame origin of ``foot``, shape (3,)."""
+    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
+        """World position [m] of the sole frame origin of ``foot``, shape (3,).
+
+        Args:
+            foot: ``"left"`` or ``"right"``.
+            forward_kinematics: Update the link transforms from the joint state
+                first. PyBullet then also refreshes the bodies' collision
+                transforms, which changes the next step's contact solution
+                slightly: an observer that must not perturb the run (the physics
+                log) passes False and reads the transforms of the last step.
+        """
         state = self.client.getLinkState(
-            self.body, self.foot_links[foot], computeForwardKinematics=1
+            self.body, self.foot_links[foot], computeForwardKinematics=int(forward_kinematics)
         )
         rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         return np.array(state[4]) + rotation @ np.array(self.description.sole_offset)

@@ -343,3 +343,24 @@ def test_the_physics_log_records_every_step_consistently(backend, tmp_path):
     impulse = column["push_fx"].sum() * 1e-3
     assert impulse == pytest.approx(2.0, rel=1e-6)
     assert np.all(column["left_sole_z"] > -0.005)
+
+
+def test_the_physics_log_observes_without_changing_the_run():
+    """A run with the log ends in exactly the state of the same run without it."""
+    from app.physics_log import PhysicsLog
+
+    def push(time):
+        return np.array([60.0, 30.0]) if 0.3 <= time < 0.4 else np.zeros(2)
+
+    finals = []
+    for logged in (False, True):
+        instance = PyBulletBackend("g1")
+        try:
+            instance.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+            if logged:
+                instance.physics_log = PhysicsLog()
+            state = stand(instance, 1.0, push)
+            finals.append(np.concatenate([state.com_position, state.com_velocity]))
+        finally:
+            instance.close()
+    np.testing.assert_array_equal(finals[0], finals[1])
