@@ -7,15 +7,17 @@ y in {+-0.025, +-0.03} m (about 17 x 6 cm); four links have no ``<inertial>``
 
 Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
 
-* ``swing_preparation_time`` T_SP = 0.5 s instead of the planner's 0.2 s: a swing
+* ``swing_preparation_time`` T_SP = 0.4 s instead of the planner's 0.2 s: a swing
   that must land 0.2 s after lift-off moves the 7 kg legs fast enough that their
   angular momentum rate (up to ~15 N m) shifts the CoP by 4-5 cm, more than the
-  whole sole, and every early step then causes the next one. Measured again with
-  the CoP loops below, on 32 pushes (4-10 N s, 8 directions, 0.1 s): at mid single
-  support T_SP 0.2/0.25/0.3/0.4/0.5 s survive 19/21/26/24/19, but at phase 0.25
-  (start of single support) 0.3 s survives 7 and 0.5 s 12, so 0.5 s is kept
-  (``rsg grid --controllers rsg --phases 0.5625,0.25 --set swing_preparation_time=0.3
-  --out DIR``; every choice below can be re-measured with ``--set`` the same way).
+  whole sole, and every early step then causes the next one (a nominal gait with
+  T_SSP = 0.3 s adjusts every step). With the upper body carrying momentum (below),
+  over 160 pushes (4-10 N s, 8 directions, 0.1 s, phases 0.25, 0.375, 0.5, 0.5625 and
+  0.625: ``rsg grid --controllers rsg --phases 0.25,0.375,0.5,0.5625,0.625 --set
+  swing_preparation_time=0.5 --out DIR``) T_SP 0.4 s does not fall after 104 and
+  recovers 75, 0.5 s 96 and 74; on the 64 at phases 0.5625 and 0.25, 0.3 s gives 26
+  (22) and 12 (4) of 32 against 28 (18) and 16 (14) for 0.4 s. Every choice below can
+  be re-measured with ``--set`` the same way.
 * ``step_reaction_time`` 0.2 s with ``swing_acceleration`` 20 m/s^2 and
   ``swing_descent_slope`` 0.5: the planner decides an early step 0.2 s before its
   touchdown and aims the QP at the state predicted then; the swing sole reaches the
@@ -77,6 +79,14 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   its jump is (4.5, 7) mm further than its last announcement; landing on the
   announcement made the feet lag the footholds by 2.3 mm more at every step
   (2.8 cm after 12 steps, e_x -> -1.2 cm). Without it the RSG walk falls at 7.0 s.
+* ``upper_body_momentum`` 2 N m s, ``upper_body_return_time`` 0.5 s,
+  ``upper_body_cancel`` 0.5 (``kinematics/upper_body.py``): the waist and the
+  shoulders (``upper_body_joints``) carry the band-passed part of the RSG's feedback
+  hdot and half of the high-passed angular momentum of the legs' swing, as joint
+  offsets realised inside the IK. Over the 160 pushes above with T_SP 0.5 s: not
+  fallen 96 instead of 82, recovered 74 instead of 38 (``--set upper_body_momentum=0``
+  for without); the 20 s walk is unchanged. Measured variants in the README ("The
+  upper body carries angular momentum").
 * ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
   30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
   toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's
@@ -182,7 +192,7 @@ G1 = RobotDescription(
         "right_shoulder_pitch_joint",
         "right_shoulder_roll_joint",
     ),
-    swing_preparation_time=0.5,
+    swing_preparation_time=0.4,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
     backend_options={
