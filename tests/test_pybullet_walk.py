@@ -161,14 +161,15 @@ def test_a_forward_push_is_recovered_with_an_adjusted_step():
     assert rsg.recovered
 
 
-def test_a_push_that_topples_no_step_is_survived_by_the_rsg():
-    """8 N s over 0.1 s at mid single support towards the front and the stance side
-    (315 deg), judged as the sweep judges the full robot: no fall within 4 s. The RSG
-    steps (adjusted steps); no-step falls."""
-    push = Push(2.75, 8.0 * np.array([np.cos(-np.pi / 4), np.sin(-np.pi / 4)]), 0.1)
+def test_a_push_that_topples_no_step_is_recovered_by_the_rsg():
+    """10 N s over 0.1 s at mid single support towards the swing side (90 deg), the
+    issue's push. The RSG steps (adjusted steps) and is back to nominal steps within 4 s;
+    no-step falls."""
+    push = Push(2.75, np.array([0.0, 10.0]), 0.1)
     scenario = Scenario("push", 6.75, (push,), reference_mass=None)
     rsg, _ = run_g1(scenario)
     no_step, _ = run_g1(scenario, controller="no-step")
     assert not rsg.fall.fell, rsg.fall.reason
     assert any(s.event["adjusted"] and s.event["t"] > push.time for s in rsg.steps)
+    assert rsg.recovered
     assert no_step.fall.fell
