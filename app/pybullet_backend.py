@@ -181,6 +181,7 @@ class PyBulletBackend:
         upper_body_momentum: float = 0.0,
         upper_body_return_time: float = 0.5,
         upper_body_cancel: float = 0.0,
+        yaw_feedback: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -267,6 +268,10 @@ class PyBulletBackend:
                 of the upper body's return to its posture [s].
             upper_body_cancel: Fraction [0, 1] of the high-passed angular momentum
                 of the IK motion (the legs' swing) the upper body takes back.
+            yaw_feedback: At the end of each double support, measure the stance
+                sole's yaw against the IK's: the IK's targets (swing sole and CoM)
+                are rotated by the difference about the stance foot, and the swing
+                sole is turned so that it lands facing forward.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -319,6 +324,9 @@ class PyBulletBackend:
         self.landing = LandingCorrection(landing_correction)
         self.foothold_feedback = foothold_feedback
         self._stance_offset = np.zeros(2)  # measured stance sole - o_H [m]
+        self.yaw_feedback = yaw_feedback
+        self._frame_yaw = 0.0  # measured stance yaw - the IK's [rad]
+        self._ik_yaw = {"left": 0.0, "right": 0.0}  # soles' yaw in the IK [rad]
         self.ankle = AnkleCopFeedback(cop_feedback)
         if not 0.0 <= cop_admittance <= 2.0:
             raise ParameterError("cop_admittance", cop_admittance, "in [0, 2]")
@@ -444,6 +452,8 @@ class PyBulletBackend:
         self.landing.reset()
         self._ik_failure = None
         self._stance_offset = np.zeros(2)
+        self._frame_yaw = 0.0
+        self._ik_yaw = {"left": 0.0, "right": 0.0}
         self.ankle.reset()
         if self.flywheel is not None:
             self.flywheel.reset()
@@ -470,6 +480,9 @@ class PyBulletBackend:
             self.swing.start(np.asarray(command.previous_stance.position, float))
             self._stance = stance
         com_target = self._advance_com_reference(command)
+        foothold = np.asarray(command.stance.position, float)
+        if self.yaw_feedback:
+            com_target = foothold + _rotate(com_target - foothold, -self._frame_yaw)
         time_since_step = command.time_since_step + dt
         # Optional touchdown before the planner's step (``touchdown_lead``); G1
         # uses 0 and unloads the old foot after the step instead (transfer_lift).
@@ -487,12 +500,20 @@ class PyBulletBackend:
         self._last_command = command
         self.landing.observe(command)
         target = self.landing.target(command)
-        if self.foothold_feedback:
-            end = self.timing.double_support
-            if command.time_since_step <= end < time_since_step:
+        end = self.timing.double_support
+        if command.time_since_step <= end < time_since_step:
+            if self.foothold_feedback:
                 sole = self.sim.sole_position(stance)[:2]
-                self._stance_offset = sole - np.asarray(command.stance.position, float)
+                self._stance_offset = sole - foothold
+            if self.yaw_feedback:
+                self._frame_yaw = _wrap(self.sim.sole_yaw(stance) - self._ik_yaw[stance])
+        if self.foothold_feedback:
             target = target - self._stance_offset
+        if self.yaw_feedback:
+            target = foothold + _rotate(target - foothold, -self._frame_yaw)
+            if time_since_step > end:  # in the air: turn to land facing forward
+                turn = _wrap(-self._frame_yaw - self._ik_yaw[swing_foot])
+                self._ik_yaw[swing_foot] += float(np.clip(turn, -YAW_RATE * dt, YAW_RATE * dt))
         swing_position = self.swing.update(time_since_step, target, dt, landing)
         swing_position[2] = max(swing_position[2] - self._press_depth(swing_position), -0.01)
         swing_position[2] = max(swing_position[2], self.landing_clearance)
@@ -504,8 +525,11 @@ class PyBulletBackend:
             lift = self.transfer_lift * min(time_since_step / self.transfer_ramp, 1.0)
             swing_position[2] = max(swing_position[2], lift)
         soles = {
-            stance: sole_pose(np.array([*command.stance.position, self._settle(time_since_step)])),
-            swing_foot: sole_pose(swing_position),
+            stance: sole_pose(
+                np.array([*command.stance.position, self._settle(time_since_step)]),
+                self._ik_yaw[stance],
+            ),
+            swing_foot: sole_pose(swing_position, self._ik_yaw[swing_foot]),
         }
 
         support = "both" if command.double_support else stance
@@ -784,3 +808,17 @@ def _tilt(quaternion_xyzw: NDArray[np.float64]) -> float:
 def _ground_pose(position_xy: NDArray[np.float64]) -> NDArray[np.float64]:
     """Flat sole pose on the ground at ``position_xy`` [m]."""
     return sole_pose(np.array([position_xy[0], position_xy[1], 0.0]))
+
+
+YAW_RATE = 2.0  # turning rate of the swing sole with ``yaw_feedback`` [rad/s]
+
+
+def _rotate(vector: NDArray[np.float64], angle: float) -> NDArray[np.float64]:
+    """``vector`` (2,) turned by ``angle`` [rad] about z."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([c * vector[0] - s * vector[1], s * vector[0] + c * vector[1]])
+
+
+def _wrap(angle: float) -> float:
+    """``angle`` [rad] in (-pi, pi]."""
+    return float(np.arctan2(np.sin(angle), np.cos(angle)))

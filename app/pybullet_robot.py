@@ -212,6 +212,14 @@ class SimulatedRobot:
         rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         return np.array(state[4]) + rotation @ np.array(self.description.sole_offset)
 
+    def sole_yaw(self, foot: str) -> float:
+        """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
+        state = self.client.getLinkState(
+            self.body, self.foot_links[foot], computeForwardKinematics=1
+        )
+        rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
     # ------------------------------------------------------------- actuation
     def set_joint_targets(
         self, angles: NDArray[np.float64], velocities: NDArray[np.float64] | None = None

@@ -4,10 +4,10 @@ The walk and paper-fig6 tests state the goal of the full-robot backend. They are
 marked ``xfail(strict=True)`` while the goal is not met, so that they start to
 fail (and the marker must go) as soon as it is. Status, measured with the G1
 defaults of ``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted,
-max V_u 0.64 gamma_v); paper-fig6 still falls at 5.1 s (its first adjusted step
-touches down 40 ms early with a 4.4 kN spike, the robot leaves the ground, and the
+max V_u 0.61 gamma_v); paper-fig6 still falls at 5.7 s (its first adjusted step
+touches down 60 ms early with a 4.5 kN spike, the robot leaves the ground, and the
 lateral DCM error grows beyond the ZMP window before the next step may land); see
-``app/pybullet_backend.py`` and ``rsg run --physics-log``.
+the README ("The full robot") and ``rsg run --physics-log``.
 """
 
 from __future__ import annotations
@@ -38,15 +38,18 @@ def run_g1(
     controller: str = "rsg",
     duration: float | None = None,
     robot: str = "g1",
+    overrides: tuple[tuple[str, str], ...] = (),
+    final_yaw: list[float] | None = None,
 ) -> tuple[RunResult, list[float]]:
     """Run ``scenario`` on ``robot`` (G1 by default); returns the result and each
     step's landing error [m].
 
     The landing error is measured at the end of the step's double support, when
     the new stance foot is down: the distance between the measured sole and the
-    planner's step position.
+    planner's step position. ``overrides`` are ``--set`` pairs; ``final_yaw``, if
+    given, receives both soles' yaw [rad] at the end.
     """
-    backend, config, initial = build_robot_backend(robot, controller)
+    backend, config, initial = build_robot_backend(robot, controller, overrides)
     if duration is not None:
         scenario = dataclasses.replace(scenario, duration=duration)
     scaled, _ = scenario.scaled_to(backend.mass)
@@ -64,6 +67,8 @@ def run_g1(
                 pending = None
             if backend.fall_status().fell:
                 break
+        if final_yaw is not None:
+            final_yaw.extend(backend.sim.sole_yaw(foot) for foot in ("left", "right"))
         return loop.result(), errors
     finally:
         backend.close()
@@ -173,3 +178,19 @@ def test_a_push_that_topples_no_step_is_recovered_by_the_rsg():
     assert any(s.event["adjusted"] and s.event["t"] > push.time for s in rsg.steps)
     assert rsg.recovered
     assert no_step.fall.fell
+
+
+def test_yaw_feedback_turns_the_robot_back_to_forward_after_a_push():
+    """6 N s to the left at mid single support turns G1 by 2-3 deg about the vertical.
+    With ``yaw_feedback`` the swing soles land facing forward again: the run is
+    recovered and both soles end within 1 deg of forward. Without it nothing turns
+    the robot back: it keeps turning (5-8 deg) and falls within the 8 s."""
+    push = Push(2.75, np.array([0.0, 6.0]), 0.1)
+    scenario = Scenario("push", 10.75, (push,), reference_mass=None)
+    yaw: list[float] = []
+    fed, _ = run_g1(scenario, overrides=(("yaw_feedback", "true"),), final_yaw=yaw)
+    assert fed.recovered, fed.fall.reason
+    assert np.degrees(np.abs(yaw)).max() < 1.0
+    open_loop_yaw: list[float] = []
+    unfed, _ = run_g1(scenario, overrides=(("yaw_feedback", "false"),), final_yaw=open_loop_yaw)
+    assert unfed.fall.fell or np.degrees(np.abs(open_loop_yaw)).max() > 3.0
