@@ -344,8 +344,6 @@ class PyBulletBackend:
                 upper_body_momentum,
                 f"0 for {self.description.name}, whose description lists no upper_body_joints",
             )
-        self.upper_body_momentum = upper_body_momentum
-        self.upper_body_return_time = upper_body_return_time
         self._last_command: PlannerOutput | None = None
         #: Set to a :class:`app.physics_log.PhysicsLog` to record every physics step.
         self.physics_log: PhysicsLog | None = None
@@ -374,6 +372,7 @@ class PyBulletBackend:
             self.flywheel = UpperBodyFlywheel(
                 self.ik.robot,
                 self.ik.upper_body_joints,
+                self.ik.upper_body_posture,
                 return_time=upper_body_return_time,
                 max_momentum=upper_body_momentum,
                 cancel=upper_body_cancel,
@@ -675,10 +674,7 @@ class PyBulletBackend:
             return None
         rest = self.ik.angular_momentum[:2] - self.flywheel.momentum
         return self.flywheel.follow_rate(
-            command.angular_momentum_rate_feedback,
-            self.ik.upper_body_posture,
-            self.control_period,
-            rest,
+            command.angular_momentum_rate_feedback, self.control_period, rest
         )
 
     def _ankle_joint_names(self, foot: str) -> list[str]:

@@ -195,29 +195,32 @@ class SimulatedRobot:
         """URDF name of PyBullet link index ``link`` (-1: the base)."""
         return self._link_names.get(link, str(link))
 
-    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
-        """World position [m] of the sole frame origin of ``foot``, shape (3,).
+    def _foot_frame(
+        self, foot: str, forward_kinematics: bool
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World position [m] and rotation of ``foot``'s ankle link frame.
 
-        Args:
-            foot: ``"left"`` or ``"right"``.
-            forward_kinematics: Update the link transforms from the joint state
-                first. PyBullet then also refreshes the bodies' collision
-                transforms, which changes the next step's contact solution
-                slightly: an observer that must not perturb the run (the physics
-                log) passes False and reads the transforms of the last step.
+        ``forward_kinematics``: update the link transforms from the joint state
+        first. PyBullet then also refreshes the bodies' collision transforms, which
+        changes the next step's contact solution slightly: an observer that must
+        not perturb the run (the physics log) passes False and reads the
+        transforms of the last step.
         """
         state = self.client.getLinkState(
             self.body, self.foot_links[foot], computeForwardKinematics=int(forward_kinematics)
         )
         rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
-        return np.array(state[4]) + rotation @ np.array(self.description.sole_offset)
+        return np.array(state[4]), rotation
+
+    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
+        """World position [m] of the sole frame origin of ``foot``, shape (3,)
+        (``forward_kinematics``: see :meth:`_foot_frame`)."""
+        origin, rotation = self._foot_frame(foot, forward_kinematics)
+        return origin + rotation @ np.array(self.description.sole_offset)
 
     def sole_yaw(self, foot: str) -> float:
         """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
-        state = self.client.getLinkState(
-            self.body, self.foot_links[foot], computeForwardKinematics=1
-        )
-        rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        _, rotation = self._foot_frame(foot, True)
         return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
 
     # ------------------------------------------------------------- actuation

@@ -49,6 +49,7 @@ class UpperBodyFlywheel:
         robot: placo ``RobotWrapper`` of the IK model (its centroidal map and joint
             velocity indices are used).
         joints: Names of the upper-body joints that carry the momentum.
+        posture: Standing angles of ``joints`` [rad], from which the offsets count.
         max_offset: Largest offset from the standing posture per joint [rad].
         return_time: T_r, time constant [s] of the band-pass on hdot and of the
             offsets' return to zero.
@@ -63,6 +64,7 @@ class UpperBodyFlywheel:
         self,
         robot,  # noqa: ANN001 (placo.RobotWrapper)
         joints: Sequence[str],
+        posture: NDArray[np.float64],
         max_offset: float = 0.4,
         return_time: float = 0.5,
         max_momentum: float = 1.0,
@@ -92,8 +94,12 @@ class UpperBodyFlywheel:
         self._v_index = [robot.get_joint_v_offset(name) for name in self.joints]
         model = robot.model
         q_index = [model.joints[model.getJointId(name)].idx_q for name in self.joints]
-        self._lower = np.asarray(model.lowerPositionLimit, float)[q_index]
-        self._upper = np.asarray(model.upperPositionLimit, float)[q_index]
+        posture = np.asarray(posture, float)
+        if posture.shape != (len(self.joints),):
+            raise ParameterError("posture", posture.shape, f"one angle per joint, ({len(joints)},)")
+        # Offset bounds [rad]: max_offset, within the joint limits.
+        self._low = np.maximum(-max_offset, np.asarray(model.lowerPositionLimit)[q_index] - posture)
+        self._high = np.minimum(max_offset, np.asarray(model.upperPositionLimit)[q_index] - posture)
         self.offsets = np.zeros(len(self.joints))
         self.momentum = np.zeros(2)
         self.target = np.zeros(2)  # h* [N m s]
@@ -111,7 +117,6 @@ class UpperBodyFlywheel:
     def follow_rate(
         self,
         rate: NDArray[np.float64],
-        posture: NDArray[np.float64],
         dt: float,
         motion_momentum: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
@@ -119,7 +124,6 @@ class UpperBodyFlywheel:
 
         Args:
             rate: Commanded horizontal hdot [N m], (2,).
-            posture: Standing angles of :attr:`joints` [rad].
             dt: Time step [s].
             motion_momentum: Angular momentum of the rest of the whole-body motion
                 [N m s], (2,); with ``cancel`` > 0, that fraction of its
@@ -143,16 +147,13 @@ class UpperBodyFlywheel:
                 -self.max_momentum,
                 self.max_momentum,
             )
-        return self.update(wanted, posture, dt)
+        return self.update(wanted, dt)
 
-    def update(
-        self, target: NDArray[np.float64], posture: NDArray[np.float64], dt: float
-    ) -> NDArray[np.float64]:
+    def update(self, target: NDArray[np.float64], dt: float) -> NDArray[np.float64]:
         """Move the offsets for ``dt`` toward carrying ``target``.
 
         Args:
             target: Horizontal angular momentum h* for the upper body [N m s], (2,).
-            posture: Standing angles of :attr:`joints` [rad] (for the joint limits).
             dt: Time step [s].
 
         Returns:
@@ -166,9 +167,7 @@ class UpperBodyFlywheel:
         gram = a @ a.T + self.damping * np.eye(2)
         velocity = a.T @ np.linalg.solve(gram, np.asarray(target, float))
         velocity -= self.offsets / self.return_time
-        low = np.maximum(-self.max_offset, self._lower - posture)
-        high = np.minimum(self.max_offset, self._upper - posture)
-        new = np.clip(self.offsets + velocity * dt, low, high)
+        new = np.clip(self.offsets + velocity * dt, self._low, self._high)
         self.momentum = a @ ((new - self.offsets) / dt)
         self.offsets = new
         return self.offsets

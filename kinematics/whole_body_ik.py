@@ -154,10 +154,10 @@ class WholeBodyIK:
             self.trunk_task.configure("trunk", "soft", TRUNK_WEIGHT)
         self.pelvis_task = self.solver.add_orientation_task(description.base_link, np.eye(3))
         self.pelvis_task.configure("pelvis", "soft", TRUNK_WEIGHT)
-        self.posture_task = self.solver.add_joints_task()
-        self.posture_task.set_joints(self.standing_posture())
-        self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
         standing = self.standing_posture()
+        self.posture_task = self.solver.add_joints_task()
+        self.posture_task.set_joints(standing)
+        self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
         self.upper_body_posture = np.array([standing[name] for name in self.upper_body_joints])
         self.momentum_task = None
         if use_angular_momentum:

@@ -50,10 +50,10 @@ def centroidal_angular_momentum(ik, joints, joint_velocity):
 
 def test_the_offsets_carry_the_target_angular_momentum(ik):
     joints = list(G1.upper_body_joints)
-    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=100.0)
+    flywheel = UpperBodyFlywheel(ik.robot, joints, posture(joints), return_time=100.0)
     target = np.array([0.15, -0.2])  # [N m s]
     before = flywheel.offsets.copy()
-    flywheel.update(target, posture(joints), DT)
+    flywheel.update(target, DT)
     joint_velocity = (flywheel.offsets - before) / DT
     realised = centroidal_angular_momentum(ik, joints, joint_velocity)
     np.testing.assert_allclose(realised[:2], target, atol=0.01 * np.linalg.norm(target))
@@ -65,14 +65,16 @@ def test_the_offsets_carry_the_target_angular_momentum(ik):
 
 def test_the_offsets_stay_within_their_range_and_then_carry_nothing(ik):
     joints = list(G1.upper_body_joints)
-    flywheel = UpperBodyFlywheel(ik.robot, joints, max_offset=0.3, return_time=100.0)
+    flywheel = UpperBodyFlywheel(
+        ik.robot, joints, posture(joints), max_offset=0.3, return_time=100.0
+    )
     stand = posture(joints)
     model = ik.robot.model
     q_index = [model.joints[model.getJointId(name)].idx_q for name in joints]
     lower = np.asarray(model.lowerPositionLimit)[q_index]
     upper = np.asarray(model.upperPositionLimit)[q_index]
     for _ in range(300):  # 1 N m s held for 3 s: the waist would turn ~3 rad
-        flywheel.update(np.array([1.0, 1.0]), stand, DT)
+        flywheel.update(np.array([1.0, 1.0]), DT)
         assert np.all(np.abs(flywheel.offsets) <= 0.3 + 1e-12)
         assert np.all(stand + flywheel.offsets >= lower - 1e-12)
         assert np.all(stand + flywheel.offsets <= upper + 1e-12)
@@ -81,22 +83,23 @@ def test_the_offsets_stay_within_their_range_and_then_carry_nothing(ik):
 
 def test_a_steady_rate_is_left_to_the_cop_and_a_pulse_is_carried_then_returned(ik):
     joints = list(G1.upper_body_joints)
-    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=0.5, max_momentum=1.0)
-    stand = posture(joints)
+    flywheel = UpperBodyFlywheel(
+        ik.robot, joints, posture(joints), return_time=0.5, max_momentum=1.0
+    )
     for _ in range(500):  # 5 s of a steady 0.3 N m about x
-        flywheel.follow_rate(np.array([0.3, 0.0]), stand, DT)
+        flywheel.follow_rate(np.array([0.3, 0.0]), DT)
     assert abs(flywheel.target[0]) < 1e-3
     assert np.all(np.abs(flywheel.offsets) < 0.01)
     flywheel.reset()
     peak = 0.0
     for _ in range(20):  # 3 N m about y for 0.2 s (a saturated feedback after a push)
-        flywheel.follow_rate(np.array([0.0, 3.0]), stand, DT)
+        flywheel.follow_rate(np.array([0.0, 3.0]), DT)
         peak = max(peak, flywheel.target[1])
     assert 0.3 < peak <= 1.0  # about 3 N m x 0.2 s, less the band-pass
     pitch = flywheel.offsets[joints.index("waist_pitch_joint")]
     assert pitch != 0.0
     for _ in range(500):  # no more hdot: the upper body returns to its posture
-        flywheel.follow_rate(np.zeros(2), stand, DT)
+        flywheel.follow_rate(np.zeros(2), DT)
     assert abs(flywheel.target[1]) < 0.01
     assert np.all(np.abs(flywheel.offsets) < 0.1 * abs(pitch))
 
@@ -105,13 +108,14 @@ def test_the_upper_body_takes_back_part_of_the_legs_swinging_momentum(ik):
     """A 1.25 Hz oscillation of the rest of the motion's momentum (the legs' swing) is
     carried back by the upper body at the fraction ``cancel``; its mean is not."""
     joints = list(G1.upper_body_joints)
-    flywheel = UpperBodyFlywheel(ik.robot, joints, return_time=0.5, max_momentum=2.0, cancel=0.5)
-    stand = posture(joints)
+    flywheel = UpperBodyFlywheel(
+        ik.robot, joints, posture(joints), return_time=0.5, max_momentum=2.0, cancel=0.5
+    )
     carried, legs = [], []
     for tick in range(560):
         time = tick * DT
         motion = np.array([0.2 + 0.4 * np.sin(2 * np.pi * 1.25 * time), 0.0])  # [N m s]
-        flywheel.follow_rate(np.zeros(2), stand, DT, motion)
+        flywheel.follow_rate(np.zeros(2), DT, motion)
         carried.append(flywheel.momentum[0])
         legs.append(motion[0] - 0.2)
     carried, legs = np.array(carried[240:]), np.array(legs[240:])  # 4 periods
@@ -123,13 +127,13 @@ def test_the_upper_body_takes_back_part_of_the_legs_swinging_momentum(ik):
 
 def test_the_flywheel_checks_its_parameters(ik):
     with pytest.raises(ParameterError, match="upper_body_joints"):
-        UpperBodyFlywheel(ik.robot, ["no_such_joint"])
+        UpperBodyFlywheel(ik.robot, ["no_such_joint"], np.zeros(1))
     with pytest.raises(ParameterError, match="max_offset"):
-        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], max_offset=2.0)
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], np.zeros(1), max_offset=2.0)
     with pytest.raises(ParameterError, match="max_momentum"):
-        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], max_momentum=0.0)
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], np.zeros(1), max_momentum=0.0)
     with pytest.raises(ParameterError, match="cancel"):
-        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], cancel=1.5)
+        UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], np.zeros(1), cancel=1.5)
 
 
 def test_a_robot_without_upper_body_joints_cannot_carry_momentum():
