@@ -65,7 +65,12 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
                    help="push phases, fractions of the walking cycle (default 0.5625: mid "
                    "single support)")  # fmt: skip
     p.add_argument("--duration", type=float, default=0.1, help="push duration [s] (0.1)")
-    p.add_argument("--settle", type=float, default=4.0, help="time after the push [s] (4)")
+    p.add_argument(
+        "--settle",
+        type=float,
+        default=GridSpec.settle,
+        help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
+    )
     p.add_argument("--paper-rules", action="store_true",
                    help="the RSG without the documented extensions")  # fmt: skip
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")

@@ -71,7 +71,7 @@ class GridSpec:
     phases: tuple[float, ...] = (0.5625,)
     duration: float = 0.1
     cycle: int = 3
-    settle: float = 4.0
+    settle: float = 8.0
     paper_rules: bool = False
     fall_dcm_error: float = 2.0
     overrides: Overrides = ()

@@ -14,10 +14,11 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   T_SSP = 0.3 s adjusts every step). With the upper body carrying momentum (below),
   over 160 pushes (4-10 N s, 8 directions, 0.1 s, phases 0.25, 0.375, 0.5, 0.5625 and
   0.625: ``rsg grid --controllers rsg --phases 0.25,0.375,0.5,0.5625,0.625 --set
-  swing_preparation_time=0.5 --out DIR``) T_SP 0.4 s does not fall after 104 and
-  recovers 75, 0.5 s 96 and 74; on the 64 at phases 0.5625 and 0.25, 0.3 s gives 26
-  (22) and 12 (4) of 32 against 28 (18) and 16 (14) for 0.4 s. Every choice below can
-  be re-measured with ``--set`` the same way.
+  swing_preparation_time=0.5 --settle 4 --out DIR``, before yaw feedback) T_SP 0.4 s did
+  not fall after 104 and recovered 75, 0.5 s 96 and 74. With yaw feedback and 8 s to
+  settle, on the 64 at phases 0.5625 and 0.25, 0.4 s is not fallen after 18 and 16 of 32
+  (all recovered), 0.5 s after 19 (18) and 14 (14), 0.3 s after 16 (14) and 4 (4).
+  Every choice below can be re-measured with ``--set`` the same way.
 * ``step_reaction_time`` 0.2 s with ``swing_acceleration`` 20 m/s^2 and
   ``swing_descent_slope`` 0.5: the planner decides an early step 0.2 s before its
   touchdown and aims the QP at the state predicted then; the swing sole reaches the
@@ -87,6 +88,14 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   fallen 96 instead of 82, recovered 74 instead of 38 (``--set upper_body_momentum=0``
   for without); the 20 s walk is unchanged. Measured variants in the README ("The
   upper body carries angular momentum").
+* ``yaw_feedback``: at the end of each double support the stance sole's measured
+  yaw is compared with the IK's; the IK's swing-sole and CoM targets are turned by the
+  difference about the stance foot, and the swing sole turns in the air to land facing
+  forward. After pushes G1 turns about the vertical (the stance sole spins when the
+  CoP sits on a sole edge or corner, where one or two contact points carry the
+  weight: 5 deg within 0.2 s after 10 N s backwards), and without it nothing turned it
+  back. Over the 160 pushes above with 8 s to settle (``--settle 8``), not fallen 80
+  and recovered 80 with it, 65 and 57 without (``--set yaw_feedback=false``).
 * ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
   30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
   toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's
@@ -204,5 +213,6 @@ G1 = RobotDescription(
         "upper_body_momentum": 2.0,
         "upper_body_return_time": 0.5,
         "upper_body_cancel": 0.5,
+        "yaw_feedback": True,
     },
 )
