@@ -182,6 +182,7 @@ class PyBulletBackend:
         upper_body_return_time: float = 0.5,
         upper_body_cancel: float = 0.0,
         yaw_feedback: bool = False,
+        reanchor_stance: bool = False,
     ) -> None:
         """Load the robot.
 
@@ -272,6 +273,10 @@ class PyBulletBackend:
                 sole's yaw against the IK's: the IK's targets (swing sole and CoM)
                 are rotated by the difference about the stance foot, and the swing
                 sole is turned so that it lands facing forward.
+            reanchor_stance: At the end of each double support the measured stance
+                sole goes to the planner (``MeasuredState.stance_sole``), which moves
+                its stance foothold there; ``foothold_feedback`` then has nothing
+                left to correct.
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         substeps = round(control_period / PHYSICS_TIME_STEP)
@@ -325,6 +330,8 @@ class PyBulletBackend:
         self.foothold_feedback = foothold_feedback
         self._stance_offset = np.zeros(2)  # measured stance sole - o_H [m]
         self.yaw_feedback = yaw_feedback
+        self.reanchor_stance = reanchor_stance
+        self._report_stance = False
         self._frame_yaw = 0.0  # measured stance yaw - the IK's [rad]
         self._ik_yaw = {"left": 0.0, "right": 0.0}  # soles' yaw in the IK [rad]
         self.ankle = AnkleCopFeedback(cop_feedback)
@@ -501,9 +508,10 @@ class PyBulletBackend:
         target = self.landing.target(command)
         end = self.timing.double_support
         if command.time_since_step <= end < time_since_step:
-            if self.foothold_feedback:
+            if self.foothold_feedback and not self.reanchor_stance:
                 sole = self.sim.sole_position(stance)[:2]
                 self._stance_offset = sole - foothold
+            self._report_stance = self.reanchor_stance
             if self.yaw_feedback:
                 self._frame_yaw = _wrap(self.sim.sole_yaw(stance) - self._ik_yaw[stance])
         if self.foothold_feedback:
@@ -722,8 +730,12 @@ class PyBulletBackend:
         if self.ankle.enabled or self.cop_admittance > 0.0 or self.stance_switch == "contact":
             self._pressure = self.sim.foot_pressure()
         com, com_velocity = self.sim.com_state()
+        stance_sole = None
+        if self._report_stance and self._last_command is not None:
+            stance_sole = self.sim.sole_position(self._last_command.stance.foot, False)[:2].copy()
+            self._report_stance = False
         return MeasuredState(
-            self.sim.time, com[:2].copy(), com_velocity[:2].copy(), self._touchdown()
+            self.sim.time, com[:2].copy(), com_velocity[:2].copy(), self._touchdown(), stance_sole
         )
 
     def _touchdown(self) -> NDArray[np.float64] | None:

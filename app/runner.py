@@ -242,7 +242,11 @@ class ClosedLoop:
         start = wallclock.perf_counter()
         time = self.time
         measured = MeasuredState(
-            time, self.measured.com_position, self.measured.com_velocity, self.measured.touchdown
+            time,
+            self.measured.com_position,
+            self.measured.com_velocity,
+            self.measured.touchdown,
+            self.measured.stance_sole,
         )
         out = self.generator.update(measured, self.period)
         if out.step is not None:

@@ -66,6 +66,10 @@ A backend that switches the stance at measured contact reports the touchdown in
 ``MeasuredState.touchdown``: in single support the planner then jumps at once, onto
 that foothold, before its own jump time (a timing jump). The default backends do not:
 the jump happens at the planned time (why: README, "When does the stance switch?").
+A backend may also report where the stance sole stands, measured, in
+``MeasuredState.stance_sole`` (the PyBullet backend's ``reanchor_stance``, once a step
+after the double support): in single support the planner moves o_H there, so its ZMP
+window and DCM error refer to the real foot.
 
 Controllers in the same framework (``PlannerConfig.controller``):
 
@@ -325,6 +329,8 @@ class ReactiveStepGenerator:
             The command for the next ``period`` and what the planner knows now.
         """
         com = np.asarray(measured.com_position, dtype=float)
+        if measured.stance_sole is not None and not self._in_double_support():
+            self.stance = np.asarray(measured.stance_sole, dtype=float).copy()
         xi = np.concatenate([com - self.stance, np.asarray(measured.com_velocity, dtype=float)])
         self._estimate_push(com + xi[2:] / self.omega)
         error = self.dcm_error(xi)

@@ -79,12 +79,17 @@ class MeasuredState:
         touchdown: Where the swing foot has just touched the ground [m], shape (2,),
             when the backend switches the stance at measured contact; None otherwise
             (the planner then steps at its own jump time).
+        stance_sole: Where the stance foot's sole stands, measured [m], shape (2,),
+            when the backend reports it (once a step, after the double support):
+            the planner moves its stance foothold o_H there, so its ZMP window and
+            DCM error refer to the real foot. None: o_H stays where it stepped.
     """
 
     time: float
     com_position: Vector2
     com_velocity: Vector2
     touchdown: Vector2 | None = None
+    stance_sole: Vector2 | None = None
 
 
 @dataclass(frozen=True)

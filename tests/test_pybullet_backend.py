@@ -288,6 +288,32 @@ def test_foothold_feedback_aims_the_swing_foot_against_the_stance_offset():
         backend.close()
 
 
+def test_reanchor_reports_the_measured_stance_sole_once_after_the_double_support():
+    """With ``reanchor_stance`` the measured state carries the stance sole, as measured,
+    at the end of the double support and at no other tick; the foothold feedback then
+    keeps no offset of its own."""
+    backend = PyBulletBackend("g1", foothold_feedback=True, reanchor_stance=True)
+    try:
+        shifted = Foothold("left", LEFT.position + np.array([0.01, 0.0]))  # o_H 1 cm ahead
+        backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+        reports = []
+        for tick in range(30):
+            since = tick * backend.control_period
+            state = backend.step(
+                command(since, LEFT.position, stance=shifted, since_step=since), np.zeros(2)
+            )
+            if state.stance_sole is not None:
+                reports.append((since, state.stance_sole, backend.sim.sole_position("left", False)))
+        assert len(reports) == 1
+        since, sole, measured = reports[0]
+        assert since <= 0.1 < since + backend.control_period  # T_DSP = 0.1 s
+        np.testing.assert_allclose(sole, measured[:2], atol=1e-9)
+        assert sole[0] == pytest.approx(LEFT.position[0], abs=0.004)  # not at o_H
+        np.testing.assert_array_equal(backend._stance_offset, np.zeros(2))
+    finally:
+        backend.close()
+
+
 @pytest.mark.parametrize("switch", ["planned", "contact"])
 def test_a_touchdown_is_reported_only_when_the_stance_switches_at_contact(switch):
     """The swing sole landing under load within CONTACT_WINDOW of the planned step is a

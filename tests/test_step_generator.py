@@ -317,3 +317,29 @@ def test_a_measured_touchdown_is_a_jump_onto_it_in_single_support_only():
     assert out.stance.foot == "right"
     u_d = landed - np.array([0.0, 0.1])
     np.testing.assert_allclose(out.dcm_error, error_before - u_d + 2 * reference_xi1, atol=1e-9)
+
+
+def test_a_measured_stance_sole_moves_the_foothold_in_single_support_only():
+    """MeasuredState.stance_sole re-anchors o_H where the stance sole stands: the ZMP
+    window and the DCM error then refer to it (e_u moves by the anchor's shift); in
+    the double support it is ignored."""
+    config = PlannerConfig()
+    gen = ReactiveStepGenerator(config)
+    planned = np.array([0.0, 0.1])
+    gen.reset(
+        Foothold("left", planned),
+        Foothold("right", np.array([-0.2, -0.1])),
+        time_since_step=0.05,  # double support
+    )
+    measured_sole = np.array([0.012, 0.093])
+    com, velocity = gen.initial_com_state()
+    out = gen.update(MeasuredState(0.0, com, velocity, stance_sole=measured_sole), 0.01)
+    np.testing.assert_allclose(out.stance.position, planned)
+    gen.time_since_step = 0.3  # single support
+    com, velocity = gen.initial_com_state()
+    expected = gen.dcm_error(np.r_[com - planned, velocity]) - (measured_sole - planned)
+    out = gen.update(MeasuredState(0.01, com, velocity, stance_sole=measured_sole), 0.01)
+    assert out.step is None
+    np.testing.assert_allclose(out.stance.position, measured_sole)
+    np.testing.assert_allclose(out.window_center, measured_sole)
+    np.testing.assert_allclose(out.dcm_error, expected, atol=1e-9)
