@@ -288,11 +288,15 @@ def test_foothold_feedback_aims_the_swing_foot_against_the_stance_offset():
         backend.close()
 
 
-def test_reanchor_reports_the_measured_stance_sole_once_after_the_double_support():
+@pytest.mark.parametrize("reanchor_min", [0.0, 0.02])
+def test_reanchor_reports_the_measured_stance_sole_once_after_the_double_support(reanchor_min):
     """With ``reanchor_stance`` the measured state carries the stance sole, as measured,
-    at the end of the double support and at no other tick; the foothold feedback then
-    keeps no offset of its own."""
-    backend = PyBulletBackend("g1", foothold_feedback=True, reanchor_stance=True)
+    at the end of the double support and at no other tick, when it stands further than
+    ``reanchor_min`` from the planner's foothold (here 1.2 cm); the foothold feedback
+    then keeps no offset of its own. A nearer sole is left to the foothold feedback."""
+    backend = PyBulletBackend(
+        "g1", foothold_feedback=True, reanchor_stance=True, reanchor_min=reanchor_min
+    )
     try:
         shifted = Foothold("left", LEFT.position + np.array([0.01, 0.0]))  # o_H 1 cm ahead
         backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
@@ -304,6 +308,10 @@ def test_reanchor_reports_the_measured_stance_sole_once_after_the_double_support
             )
             if state.stance_sole is not None:
                 reports.append((since, state.stance_sole, backend.sim.sole_position("left", False)))
+        if reanchor_min > 0.0:
+            assert reports == []
+            assert backend._stance_offset[0] == pytest.approx(-0.01, abs=0.004)
+            return
         assert len(reports) == 1
         since, sole, measured = reports[0]
         assert since <= 0.1 < since + backend.control_period  # T_DSP = 0.1 s
