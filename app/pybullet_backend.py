@@ -521,8 +521,8 @@ class PyBulletBackend:
                 # A far sole re-anchors the planner; a near one is left to the foothold
                 # feedback (re-anchoring every step moved the walk's DCM error by the
                 # landing's few mm: V_u peak 1.52 gamma_v instead of 0.67).
-                self._stance_offset = offset if self.foothold_feedback and not far else 0 * offset
                 self._report_stance = far
+                self._stance_offset = offset if self.foothold_feedback and not far else np.zeros(2)
             if self.yaw_feedback:
                 self._frame_yaw = _wrap(self.sim.sole_yaw(stance) - self._ik_yaw[stance])
         if self.foothold_feedback:
