@@ -64,6 +64,7 @@ DESCRIPTION_FIELDS = {
     "swing_preparation_time": "float",
     "filter_time_constant": "float",
     "step_reaction_time": "float",
+    "reanchor_time": "float",
 }
 
 #: Backend keyword arguments that are not options of a run.

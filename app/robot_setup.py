@@ -64,6 +64,7 @@ def planner_config_for(
             swing_preparation_time=description.swing_preparation_time,
             filter_time_constant=description.filter_time_constant,
             step_reaction_time=description.step_reaction_time,
+            reanchor_time=description.reanchor_time,
             push_hold_time=0.0,  # the paper's D_T: no push estimate from the robot's CoM
         ),
         controller=controller,

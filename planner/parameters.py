@@ -191,6 +191,8 @@ class RsgParameters:
             jump set exactly.
         push_cmp_threshold: Size of the estimated push, as the CMP shift
             |f| c_z / (m g) it causes [m], above which a push counts as under way.
+        reanchor_time: Time constant [s] with which o_H moves to a measured stance
+            sole (``MeasuredState.stance_sole``); 0: at once.
     """
 
     filter_time_constant: float = 0.05
@@ -205,10 +207,12 @@ class RsgParameters:
     step_reaction_time: float = 0.0
     push_hold_time: float = 0.15
     push_cmp_threshold: float = 0.02
+    reanchor_time: float = 0.0
 
     def __post_init__(self) -> None:
         _check_range("step_reaction_time", self.step_reaction_time, 0.0, 1.0)
         _check_range("push_hold_time", self.push_hold_time, 0.0, 1.0)
+        _check_range("reanchor_time", self.reanchor_time, 0.0, 1.0)
         _check_positive(
             self,
             "filter_time_constant",

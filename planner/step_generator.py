@@ -69,7 +69,10 @@ the jump happens at the planned time (why: README, "When does the stance switch?
 A backend may also report where the stance sole stands, measured, in
 ``MeasuredState.stance_sole`` (the PyBullet backend's ``reanchor_stance``, once a step
 after the double support): in single support the planner moves o_H there, so its ZMP
-window and DCM error refer to the real foot.
+window and DCM error refer to the real foot. With ``RsgParameters.reanchor_time`` tau > 0
+o_H approaches the sole as a first-order lag (each tick by period / tau of the gap) instead
+of at once, so the DCM error moves by the landing offset over tau instead of in one tick;
+a step ends a re-anchoring still under way.
 
 Controllers in the same framework (``PlannerConfig.controller``):
 
@@ -148,6 +151,7 @@ class ReactiveStepGenerator:
         self._last_period = 0.0
         self.push_estimate = np.zeros(2)  # f c_z / (m g): CMP shift by the push [m]
         self.push_duration = 0.0  # time the estimate has been above the threshold [s]
+        self._reanchor_target: np.ndarray | None = None  # measured stance sole [m]
 
     def initial_com_state(self) -> tuple[np.ndarray, np.ndarray]:
         """CoM position and velocity [m], [m/s] of the reference at the current state."""
@@ -330,7 +334,9 @@ class ReactiveStepGenerator:
         """
         com = np.asarray(measured.com_position, dtype=float)
         if measured.stance_sole is not None and not self._in_double_support():
-            self.stance = np.asarray(measured.stance_sole, dtype=float).copy()
+            self._reanchor_target = np.asarray(measured.stance_sole, dtype=float).copy()
+        if self._reanchor_target is not None:
+            self._reanchor(period)
         xi = np.concatenate([com - self.stance, np.asarray(measured.com_velocity, dtype=float)])
         self._estimate_push(com + xi[2:] / self.omega)
         error = self.dcm_error(xi)
@@ -360,6 +366,7 @@ class ReactiveStepGenerator:
             qp_infeasible = not feasible
             window_now = self.stance + self.window_offset()
             self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)
+            self._reanchor_target = None
             self.previous = self.stance.copy()
             self.stance = self.stance + u_d
             self.sigma = -self.sigma
@@ -413,6 +420,17 @@ class ReactiveStepGenerator:
         self.announced_step = output.next_step.position.copy() if scheduled else None
         self._flow(error, window_offset, period)
         return output
+
+    def _reanchor(self, period: float) -> None:
+        """Move o_H towards the measured stance sole (``reanchor_time``: at once if 0)."""
+        target = self._reanchor_target
+        assert target is not None
+        ramp = self.config.rsg.reanchor_time
+        fraction = 1.0 if ramp <= 0.0 else min(period / ramp, 1.0)
+        self.stance = self.stance + fraction * (target - self.stance)
+        if fraction >= 1.0 or float(np.linalg.norm(target - self.stance)) < 1e-4:
+            self.stance = target.copy()
+            self._reanchor_target = None
 
     def _flow(self, error: np.ndarray, window_offset: np.ndarray, period: float) -> None:
         """Flow of nu and of the reference model over ``period`` [s]."""

@@ -104,6 +104,9 @@ class RobotDescription:
         step_reaction_time: Time [s] the swing foot needs between the planner's
             decision to step early and the touchdown
             (``RsgParameters.step_reaction_time``).
+        reanchor_time: Time constant [s] with which the planner moves its foothold
+            to a measured stance sole (``RsgParameters.reanchor_time``; backend
+            option ``reanchor_stance``); 0: at once.
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         upper_body_joints: Joints that turn the torso and the arms, used to carry
@@ -141,6 +144,7 @@ class RobotDescription:
     swing_preparation_time: float = 0.2
     filter_time_constant: float = 0.05
     step_reaction_time: float = 0.0
+    reanchor_time: float = 0.0
     sole_box_collision: bool = False
     upper_body_joints: tuple[str, ...] = ()
     backend_options: Mapping[str, Any] = field(default_factory=dict)

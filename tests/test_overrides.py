@@ -19,6 +19,7 @@ from app.setup import build_backend
 from app.sweep import SweepSpec, run_sweep
 from planner.exceptions import ParameterError
 from planner.types import Push
+from robots import get_robot
 
 
 def test_values_are_parsed_by_the_kind_of_the_parameter() -> None:
@@ -230,3 +231,15 @@ def test_g1_steps_too_late_for_a_push_towards_its_stance_side_at_its_own_t_sp() 
     assert outcomes["0.5"][0.0] == outcomes["0.3"][0.0] == "recovered"
     assert outcomes["0.5"][270.0] == "fell"
     assert outcomes["0.3"][270.0] == "recovered"
+
+
+def test_the_reanchor_time_of_a_robot_reaches_its_planner() -> None:
+    """G1's description sets the planner's reanchor_time; --set changes it on the robot's
+    planner (here on the point mass), and a value out of range names the field."""
+    _, config, _ = build_backend("lipm", "g1", "rsg")
+    assert config.rsg.reanchor_time == get_robot("g1").reanchor_time > 0.0
+    _, config, _ = build_backend("lipm", "g1", "rsg", overrides=(("reanchor_time", "0.05"),))
+    assert config.rsg.reanchor_time == 0.05
+    with pytest.raises(ParameterError) as error:
+        build_backend("lipm", "g1", "rsg", overrides=(("reanchor_time", "2"),))
+    assert error.value.field == "reanchor_time"

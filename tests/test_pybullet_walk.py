@@ -1,13 +1,13 @@
 """The RSG walking the Unitree G1 in PyBullet (slow: full-robot runs).
 
-The walk and paper-fig6 tests state the goal of the full-robot backend. They are
-marked ``xfail(strict=True)`` while the goal is not met, so that they start to
-fail (and the marker must go) as soon as it is. Status, measured with the G1
-defaults of ``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted,
-max V_u 0.61 gamma_v); paper-fig6 still falls at 5.7 s (its first adjusted step
-touches down 60 ms early with a 4.5 kN spike, the robot leaves the ground, and the
-lateral DCM error grows beyond the ZMP window before the next step may land); see
-the README ("The full robot") and ``rsg run --physics-log``.
+The walk, push and paper-fig6 tests state the goals of the full-robot backend. Those
+not met yet are marked ``xfail(strict=True)``, so that they start to fail (and the
+marker must go) as soon as they are. Status, measured with the G1 defaults of
+``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted, max V_u 0.67
+gamma_v); 10 N s at mid single support is recovered in 5 of 8 directions; paper-fig6
+still falls at 5.0 s (its first adjusted step touches down 65 ms early, the robot
+leaves the ground, and the lateral DCM error grows beyond the ZMP window before the
+next step may land); see the README ("The full robot") and ``rsg run --physics-log``.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.push_grid import GridJob, GridSpec, run_grid_job
+from app.push_grid import GridSpec, run_grid
 from app.robot_setup import build_robot_backend
 from app.runner import ClosedLoop, RunResult
 from app.scenarios import BUILT_IN, Scenario
@@ -26,7 +26,7 @@ from planner.types import Push
 pytestmark = pytest.mark.slow
 
 LANDING_TOLERANCE = 0.03  # [m] measured sole vs. the planner's step position
-NOT_YET = "G1 paper-fig6 not achieved yet: falls 1.1 s after the first push"
+NOT_YET = "G1 paper-fig6 not achieved yet: falls 1.2 s after the first push"
 
 
 @pytest.fixture(autouse=True)
@@ -167,32 +167,58 @@ def test_a_forward_push_is_recovered_with_an_adjusted_step():
     assert rsg.recovered
 
 
-def test_a_push_that_topples_no_step_is_recovered_by_the_rsg():
-    """The issue's push, 10 N s over 0.1 s at mid single support, backwards and towards
-    the stance side (225 deg), run as ``rsg grid`` runs it: the RSG takes adjusted steps
-    and is back to nominal steps, with V_u below gamma_v, 8 s after the push; no-step
-    falls. (Single outcomes on G1 are sensitive to round-off: the same push built
-    another way, or solved with the other QP solver, can end otherwise; the grid's
-    counts in the README are the steadier measure.)"""
+@pytest.fixture(scope="module")
+def issue_pushes():
+    """The issue's pushes, run as ``rsg grid --impulses 10 --controllers rsg,no-step`` runs
+    them: 10 N s over 0.1 s at mid single support (phase 0.5625), 8 directions, 8 s to
+    settle. Returns {controller: {direction [deg]: record}}. (Single outcomes on G1 are
+    sensitive to round-off: the same push built another way, or solved with the other QP
+    solver, can end otherwise; the grid's own jobs are what the README reports.)"""
     spec = GridSpec(controllers=("rsg", "no-step"), impulses=(10.0,), directions=8)
-    rsg = run_grid_job(spec, GridJob("rsg", 0.5625, 225.0, 10.0))
-    no_step = run_grid_job(spec, GridJob("no-step", 0.5625, 225.0, 10.0))
-    assert rsg["outcome"] == "recovered", rsg["fall_reason"]
-    assert rsg["adjusted_steps"] > 0
-    assert no_step["outcome"] == "fell"
+    records = run_grid(spec, workers=2, progress=False)
+    by_controller: dict[str, dict[float, dict]] = {"rsg": {}, "no-step": {}}
+    for record in records:
+        by_controller[record["controller"]][record["direction_deg"]] = record
+    return by_controller
+
+
+def test_10_n_s_at_mid_single_support_topples_no_step_and_the_rsg_recovers_most(issue_pushes):
+    """no-step falls after at least half of the 8 pushes (measured: all 8); the RSG
+    recovers, with adjusted steps, at least 5 of them (measured: 0, 45, 180, 225 and 315
+    deg), among them 225 deg, backwards towards the stance side, where no-step falls."""
+    rsg, no_step = issue_pushes["rsg"], issue_pushes["no-step"]
+    assert sum(r["outcome"] == "fell" for r in no_step.values()) >= 4
+    recovered = [d for d, r in rsg.items() if r["outcome"] == "recovered"]
+    assert len(recovered) >= 5, {d: (r["outcome"], r["fall_reason"]) for d, r in rsg.items()}
+    assert all(rsg[d]["adjusted_steps"] > 0 for d in recovered)
+    assert 225.0 in recovered and no_step[225.0]["outcome"] == "fell"
+
+
+@pytest.mark.xfail(strict=True, reason="G1 recovers 10 N s at mid single support in 5 of 8")
+def test_10_n_s_at_mid_single_support_is_recovered_in_every_direction(issue_pushes):
+    rsg = issue_pushes["rsg"]
+    assert all(r["outcome"] == "recovered" for r in rsg.values()), {
+        d: r["outcome"] for d, r in rsg.items()
+    }
 
 
 def test_yaw_feedback_turns_the_robot_back_to_forward_after_a_push():
     """6 N s to the left at mid single support turns G1 by 2-3 deg about the vertical.
     With ``yaw_feedback`` the swing soles land facing forward again: the run is
     recovered and both soles end within 1 deg of forward. Without it nothing turns
-    the robot back: it keeps turning (5-8 deg) and falls within the 8 s."""
+    the robot back: it keeps turning (5-8 deg) and falls within the 8 s. Both runs keep
+    the foothold where the planner stepped (``reanchor_stance`` off), as when the yaw
+    feedback was measured: with G1's re-anchoring the run without it also ends within
+    1 deg of forward here."""
     push = Push(2.75, np.array([0.0, 6.0]), 0.1)
     scenario = Scenario("push", 10.75, (push,), reference_mass=None)
+    fixed = ("reanchor_stance", "false")
     yaw: list[float] = []
-    fed, _ = run_g1(scenario, overrides=(("yaw_feedback", "true"),), final_yaw=yaw)
+    fed, _ = run_g1(scenario, overrides=(fixed, ("yaw_feedback", "true")), final_yaw=yaw)
     assert fed.recovered, fed.fall.reason
     assert np.degrees(np.abs(yaw)).max() < 1.0
     open_loop_yaw: list[float] = []
-    unfed, _ = run_g1(scenario, overrides=(("yaw_feedback", "false"),), final_yaw=open_loop_yaw)
+    unfed, _ = run_g1(
+        scenario, overrides=(fixed, ("yaw_feedback", "false")), final_yaw=open_loop_yaw
+    )
     assert unfed.fall.fell or np.degrees(np.abs(open_loop_yaw)).max() > 3.0

@@ -343,3 +343,43 @@ def test_a_measured_stance_sole_moves_the_foothold_in_single_support_only():
     np.testing.assert_allclose(out.stance.position, measured_sole)
     np.testing.assert_allclose(out.window_center, measured_sole)
     np.testing.assert_allclose(out.dcm_error, expected, atol=1e-9)
+
+
+def test_a_measured_stance_sole_is_approached_with_the_reanchor_time_constant():
+    """With ``reanchor_time`` tau, o_H moves towards the measured sole by period / tau of
+    the gap per tick (the DCM error with it), reaches it, and a step before then leaves
+    the sole of the old stance foot behind."""
+    config = PlannerConfig()
+    config = replace(config, rsg=replace(config.rsg, reanchor_time=0.1))
+    gen = ReactiveStepGenerator(config)
+    planned = np.array([0.0, 0.1])
+    gen.reset(Foothold("left", planned), Foothold("right", np.array([-0.2, -0.1])), 0.15)
+    measured_sole = np.array([0.012, 0.093])
+    com, velocity = gen.initial_com_state()
+    first = planned + 0.1 * (measured_sole - planned)
+    expected = gen.dcm_error(np.r_[com - planned, velocity]) - (first - planned)
+    out = gen.update(MeasuredState(0.0, com, velocity, stance_sole=measured_sole), 0.01)
+    np.testing.assert_allclose(out.stance.position, first, atol=1e-12)
+    np.testing.assert_allclose(out.window_center, first, atol=1e-12)
+    np.testing.assert_allclose(out.dcm_error, expected, atol=1e-12)
+    for tick in range(1, 60):
+        com, velocity = gen.initial_com_state()  # on the reference: no DCM error
+        out = gen.update(MeasuredState(0.01 * tick, com, velocity), 0.01)
+        if np.array_equal(out.stance.position, measured_sole) or out.step is not None:
+            break
+    assert out.step is None
+    np.testing.assert_array_equal(out.stance.position, measured_sole)
+    # A pending re-anchoring ends at a step: the new stance foot is where it stepped.
+    gen.reset(Foothold("left", planned), Foothold("right", np.array([-0.2, -0.1])), 0.78)
+    com, velocity = gen.initial_com_state()
+    gen.update(MeasuredState(0.0, com, velocity, stance_sole=measured_sole), 0.01)
+    stepped = None
+    for tick in range(1, 10):
+        com, velocity = gen.initial_com_state()
+        out = gen.update(MeasuredState(0.01 * tick, com, velocity), 0.01)
+        if out.step is not None:
+            stepped = out
+            break
+    assert stepped is not None
+    next_out = gen.update(MeasuredState(0.1, com, velocity), 0.01)
+    np.testing.assert_array_equal(next_out.stance.position, stepped.stance.position)
