@@ -336,7 +336,7 @@ class ReactiveStepGenerator:
         if measured.stance_sole is not None and not self._in_double_support():
             self._reanchor_target = np.asarray(measured.stance_sole, dtype=float).copy()
         if self._reanchor_target is not None:
-            self._reanchor(period)
+            self._reanchor(self._reanchor_target, period)
         xi = np.concatenate([com - self.stance, np.asarray(measured.com_velocity, dtype=float)])
         self._estimate_push(com + xi[2:] / self.omega)
         error = self.dcm_error(xi)
@@ -421,10 +421,9 @@ class ReactiveStepGenerator:
         self._flow(error, window_offset, period)
         return output
 
-    def _reanchor(self, period: float) -> None:
-        """Move o_H towards the measured stance sole (``reanchor_time``: at once if 0)."""
-        target = self._reanchor_target
-        assert target is not None
+    def _reanchor(self, target: np.ndarray, period: float) -> None:
+        """Move o_H towards the measured stance sole ``target`` (``reanchor_time``: at
+        once if 0); the re-anchoring ends when o_H is there."""
         ramp = self.config.rsg.reanchor_time
         fraction = 1.0 if ramp <= 0.0 else min(period / ramp, 1.0)
         self.stance = self.stance + fraction * (target - self.stance)
