@@ -45,7 +45,8 @@ from robots.description import RobotDescription
 Overrides = tuple[tuple[str, str], ...]
 
 #: Description fields that may be set: the numbers of the gait, the planner's bounds
-#: and timing, and the fall thresholds (not the URDF, links, sole or gains).
+#: and timing, the fall thresholds and PyBullet's solver iterations (not the URDF,
+#: links, sole or gains).
 DESCRIPTION_FIELDS = {
     "com_height": "float",
     "foot_spacing": "float",
@@ -65,6 +66,7 @@ DESCRIPTION_FIELDS = {
     "filter_time_constant": "float",
     "step_reaction_time": "float",
     "reanchor_time": "float",
+    "solver_iterations": "int",
 }
 
 #: Backend keyword arguments that are not options of a run.
@@ -163,6 +165,11 @@ def parse_value(name: str, text: str, kind: str) -> Any:
         raise ParameterError(f"--set {name}", text, "true or false")
     if "str" in options:
         return text
+    if "int" in options:
+        try:
+            return int(text)
+        except ValueError:
+            raise ParameterError(f"--set {name}", text, "an integer") from None
     numbers = text.split(",")
     try:
         values = [float(part) for part in numbers]

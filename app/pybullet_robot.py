@@ -24,7 +24,6 @@ from robots.urdf_cache import derived_urdf
 
 GRAVITY = 9.81  # [m/s^2]
 PHYSICS_TIME_STEP = 1e-3  # [s]
-SOLVER_ITERATIONS = 50
 
 
 class SimulatedRobot:
@@ -44,7 +43,7 @@ class SimulatedRobot:
         client.setGravity(0.0, 0.0, -GRAVITY)
         client.setPhysicsEngineParameter(
             fixedTimeStep=PHYSICS_TIME_STEP,
-            numSolverIterations=SOLVER_ITERATIONS,
+            numSolverIterations=description.solver_iterations,
             deterministicOverlappingPairs=1,
         )
         client.setAdditionalSearchPath(pybullet_data.getDataPath())

@@ -107,6 +107,8 @@ class RobotDescription:
         reanchor_time: Time constant [s] with which the planner moves its foothold
             to a measured stance sole (``RsgParameters.reanchor_time``; backend
             option ``reanchor_stance``); 0: at once.
+        solver_iterations: Iterations of PyBullet's contact and joint-motor
+            solver per physics step (its cost grows with them; 1 to 200).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         upper_body_joints: Joints that turn the torso and the arms, used to carry
@@ -145,6 +147,7 @@ class RobotDescription:
     filter_time_constant: float = 0.05
     step_reaction_time: float = 0.0
     reanchor_time: float = 0.0
+    solver_iterations: int = 50
     sole_box_collision: bool = False
     upper_body_joints: tuple[str, ...] = ()
     backend_options: Mapping[str, Any] = field(default_factory=dict)
@@ -173,6 +176,10 @@ class RobotDescription:
             raise ParameterError("swing_height", self.swing_height, "0 < h < 0.3 m")
         if not self.ground_friction > 0.0:
             raise ParameterError("ground_friction", self.ground_friction, "> 0")
+        if not (isinstance(self.solver_iterations, int) and 1 <= self.solver_iterations <= 200):
+            raise ParameterError(
+                "solver_iterations", self.solver_iterations, "an integer from 1 to 200"
+            )
         for joint, angle in self.standing_posture.items():
             if not math.isfinite(angle):
                 raise ParameterError(f"standing_posture[{joint}]", angle, "a finite angle [rad]")

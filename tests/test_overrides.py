@@ -30,7 +30,14 @@ def test_values_are_parsed_by_the_kind_of_the_parameter() -> None:
     assert parse_value("x", "True", "bool") is True
     assert parse_value("x", "off", "bool") is False
     assert parse_value("x", "feedback", "str") == "feedback"
-    for text, kind in [("a", "float"), ("1,2", "float"), ("nan", "float"), ("maybe", "bool")]:
+    assert parse_value("x", "30", "int") == 30
+    for text, kind in [
+        ("a", "float"),
+        ("1,2", "float"),
+        ("nan", "float"),
+        ("maybe", "bool"),
+        ("2.5", "int"),
+    ]:
         with pytest.raises(ParameterError) as error:
             parse_value("x", text, kind)
         assert error.value.field == "--set x"
@@ -213,7 +220,7 @@ def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
 
 def test_g1_steps_too_late_for_a_push_towards_its_stance_side_at_its_own_t_sp() -> None:
     """The planner alone (G1's limits, a perfect point mass): 10 N s at mid single
-    support towards the stance side is lost with G1's T_SP = 0.5 s, recovered with
+    support towards the stance side is lost with T_SP = 0.5 s, recovered with
     0.3 s (the next step can come 0.2 s earlier); forward it is recovered with both."""
     outcomes = {}
     for t_sp in ("0.5", "0.3"):
@@ -243,3 +250,21 @@ def test_the_reanchor_time_of_a_robot_reaches_its_planner() -> None:
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("reanchor_time", "2"),))
     assert error.value.field == "reanchor_time"
+
+
+def test_the_solver_iterations_reach_pybullet() -> None:
+    """``--set solver_iterations=N`` sets PyBullet's contact and motor solver; a value
+    out of range names the field before any run."""
+    from app.pybullet_robot import SimulatedRobot
+
+    description, _ = robot_with_overrides("g1", (("solver_iterations", "30"),), "pybullet")
+    robot = SimulatedRobot(description)
+    try:
+        parameters = robot.client.getPhysicsEngineParameters()
+        assert parameters["numSolverIterations"] == 30
+    finally:
+        robot.close()
+    assert get_robot("g1").solver_iterations == 50
+    with pytest.raises(ParameterError) as error:
+        robot_with_overrides("g1", (("solver_iterations", "0"),), "pybullet")
+    assert error.value.field == "solver_iterations"

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from app.backend import InitialCondition
-from app.pybullet_backend import CONTACT_WINDOW, PyBulletBackend
+from app.pybullet_backend import CONTACT_WINDOW, SWING_FEEDBACK_LIMIT, PyBulletBackend
 from app.pybullet_com_plan import ADMITTANCE_LIMIT, clip_to_hull, cop_admittance_zmp
 from planner.exceptions import ParameterError
 from planner.types import Foothold, PlannerOutput, StepEvent
@@ -119,6 +119,9 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
         {"cop_admittance": -0.1},
         {"cop_admittance": 3.0},
         {"stance_switch": "early"},
+        {"swing_feedback": 1.5},
+        {"swing_feedback": -0.1},
+        {"swing_feedback_filter": 0.0},
     ],
 )
 def test_walking_options_are_validated(options):
@@ -218,6 +221,46 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     assert abs(soles["right"][2]) < 0.005
     assert "right" in backend.feet_in_contact()
     assert not backend.fall_status().fell
+
+
+@pytest.mark.parametrize("gain", [0.0, 1.0])
+def test_swing_feedback_keeps_the_real_swing_sole_on_its_trajectory_under_a_push(gain):
+    """40 N sideways on the pelvis during the swing tilts G1 on its stance leg: without
+    feedback the real swing sole ends 6.8 mm (relative to the stance sole) from where
+    the swing trajectory puts it, with ``swing_feedback`` 1 within 1 mm (measured). The
+    IK's swing sole is the trajectory's minus the filtered offset."""
+    backend = PyBulletBackend("g1", swing_feedback=gain)
+    try:
+        over_left = LEFT.position.copy()
+        backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+        planned: list[np.ndarray] = []
+        update = backend.swing.update
+
+        def recorded(*args):
+            planned.append(update(*args).copy())
+            return planned[-1].copy()
+
+        backend.swing.update = recorded
+        target = Foothold("right", np.array([0.1, -0.13]))
+        for tick in range(78):
+            time = tick * backend.control_period
+            push = np.array([0.0, 40.0]) if 0.2 < time < 0.7 else np.zeros(2)
+            backend.step(command(time, over_left, next_step=target, since_step=time), push)
+            if time > 0.1:  # single support
+                ik = backend.ik.sole_world("right")[:2, 3]
+                shifted = planned[-1][:2] - gain * backend._swing_offset
+                np.testing.assert_allclose(ik, shifted, atol=5e-4)
+        assert not backend.fall_status().fell
+        real = backend.sim.sole_position("right")[:2] - backend.sim.sole_position("left")[:2]
+        error = float(np.linalg.norm(real - (planned[-1][:2] - LEFT.position)))
+        if gain == 0.0:
+            assert error > 0.004
+            assert not backend._swing_offset.any()
+        else:
+            assert error < 0.002
+            assert 0.003 < np.linalg.norm(backend._swing_offset) <= SWING_FEEDBACK_LIMIT
+    finally:
+        backend.close()
 
 
 def test_landing_clearance_keeps_the_swing_sole_up_until_the_step(backend):

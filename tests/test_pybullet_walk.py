@@ -184,17 +184,17 @@ def issue_pushes():
 
 def test_10_n_s_at_mid_single_support_topples_no_step_and_the_rsg_recovers_most(issue_pushes):
     """no-step falls after at least half of the 8 pushes (measured: all 8); the RSG
-    recovers, with adjusted steps, at least 5 of them (measured: 0, 45, 180, 225 and 315
-    deg), among them 225 deg, backwards towards the stance side, where no-step falls."""
+    recovers, with adjusted steps, at least 6 of them (measured: all but 135 deg), among
+    them 225 deg, backwards towards the stance side, where no-step falls."""
     rsg, no_step = issue_pushes["rsg"], issue_pushes["no-step"]
     assert sum(r["outcome"] == "fell" for r in no_step.values()) >= 4
     recovered = [d for d, r in rsg.items() if r["outcome"] == "recovered"]
-    assert len(recovered) >= 5, {d: (r["outcome"], r["fall_reason"]) for d, r in rsg.items()}
+    assert len(recovered) >= 6, {d: (r["outcome"], r["fall_reason"]) for d, r in rsg.items()}
     assert all(rsg[d]["adjusted_steps"] > 0 for d in recovered)
     assert 225.0 in recovered and no_step[225.0]["outcome"] == "fell"
 
 
-@pytest.mark.xfail(strict=True, reason="G1 recovers 10 N s at mid single support in 5 of 8")
+@pytest.mark.xfail(strict=True, reason="G1 recovers 10 N s at mid single support in 7 of 8")
 def test_10_n_s_at_mid_single_support_is_recovered_in_every_direction(issue_pushes):
     rsg = issue_pushes["rsg"]
     assert all(r["outcome"] == "recovered" for r in rsg.values()), {
@@ -207,18 +207,19 @@ def test_yaw_feedback_turns_the_robot_back_to_forward_after_a_push():
     With ``yaw_feedback`` the swing soles land facing forward again: the run is
     recovered and both soles end within 1 deg of forward. Without it nothing turns
     the robot back: it keeps turning (5-8 deg) and falls within the 8 s. Both runs keep
-    the foothold where the planner stepped (``reanchor_stance`` off), as when the yaw
-    feedback was measured: with G1's re-anchoring the run without it also ends within
-    1 deg of forward here."""
+    the foothold where the planner stepped (``reanchor_stance`` off) and bound hdot to
+    3 N m, as when the yaw feedback was measured: with G1's re-anchoring the run without
+    it also ends within 1 deg of forward here, and with its 5 N m and no re-anchoring
+    the run with it falls."""
     push = Push(2.75, np.array([0.0, 6.0]), 0.1)
     scenario = Scenario("push", 10.75, (push,), reference_mass=None)
-    fixed = ("reanchor_stance", "false")
+    fixed = (("reanchor_stance", "false"), ("angular_momentum_rate_max", "3"))
     yaw: list[float] = []
-    fed, _ = run_g1(scenario, overrides=(fixed, ("yaw_feedback", "true")), final_yaw=yaw)
+    fed, _ = run_g1(scenario, overrides=(*fixed, ("yaw_feedback", "true")), final_yaw=yaw)
     assert fed.recovered, fed.fall.reason
     assert np.degrees(np.abs(yaw)).max() < 1.0
     open_loop_yaw: list[float] = []
     unfed, _ = run_g1(
-        scenario, overrides=(fixed, ("yaw_feedback", "false")), final_yaw=open_loop_yaw
+        scenario, overrides=(*fixed, ("yaw_feedback", "false")), final_yaw=open_loop_yaw
     )
     assert unfed.fall.fell or np.degrees(np.abs(open_loop_yaw)).max() > 3.0
