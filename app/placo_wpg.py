@@ -66,7 +66,7 @@ the walk goes on for 25 s with about one replan per step.
 
 Command (read from the trajectory at t): footholds of the current/next supports,
 the CoM reference ``get_p_world_CoM``, and the ZMP ``get_p_world_ZMP`` plus the
-RSG's own ZMP feedback K_p e (K_p the ZMP rows of the RSG's LQR gain, 1.85 on G1;
+RSG's own ZMP feedback K_p e (K_p the ZMP rows of the RSG's LQR gain, 1.45 on G1;
 e = measured DCM - placo's DCM), clipped to the RSG's ZMP window around the
 stance ankle (``zmp_offset``, ``window_center`` = stance ankle); hdot = 0. Why the
 feedback: placo plans a CoM trajectory for a robot that tracks it, but this

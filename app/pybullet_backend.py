@@ -60,7 +60,8 @@ Why (measured on G1, 33 kg, sole 17 cm x 5 cm, ZMP window +-2 cm laterally):
   but not the RSG (4.0-4.6 s against 5.7 s), so they are off by default.
 * Landing. Three measured mechanisms made the walk's DCM error jump at landings,
   each above the RSG's threshold (gamma_v is a DCM error of ~1.1 cm on G1: window
-  2 cm / gain 1.85), so each caused adjusted steps that stirred new errors:
+  2 cm / gain 1.85 with the 3 N m hdot bound of then), so each caused adjusted steps
+  that stirred new errors:
   (1) the planner's double-support pivot overshoots the new sole by |step| theta /
   T_DSP (theta = 0.05 s: up to 8 cm), which the sole cannot realise: G1 uses
   theta = 0.01 s (``RobotDescription.filter_time_constant``); (2) the feet landed

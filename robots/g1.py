@@ -115,7 +115,9 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   at once; time constants 0.1 s and 0.4 s gave 26 (24) and 20 (19), 24 (24) and 18 (18).
 * ``angular_momentum_rate_max`` 5 N m (the description's default is 3 N m): the
   bound on the RSG's feedback hdot per axis, i.e. a CMP shift of up to 1.5 cm on 33 kg
-  beyond what the upper body carries. On the 64 pushes at phases 0.5625 and 0.25 rsg
+  beyond what the upper body carries; it also scales hdot in the LQR design, so the ZMP
+  gain on the DCM error is 1.45 instead of 1.85 (both effects measured together). On the
+  64 pushes at phases 0.5625 and 0.25 rsg
   is not fallen after 28 (28 recovered) and 19 (19) of 32 against 24 (24) and 21 (20)
   with 3 N m; 10 N s at mid single support is recovered in 7 of 8 directions against 5
   (4, 4.5, 5.5 and 6 N m: 5, 7, 7 and 5 of 8). The 20 s walk is unchanged (no
