@@ -176,7 +176,8 @@ class RobotDescription:
             raise ParameterError("swing_height", self.swing_height, "0 < h < 0.3 m")
         if not self.ground_friction > 0.0:
             raise ParameterError("ground_friction", self.ground_friction, "> 0")
-        if not (isinstance(self.solver_iterations, int) and 1 <= self.solver_iterations <= 200):
+        iterations = self.solver_iterations
+        if type(iterations) is not int or not 1 <= iterations <= 200:  # not a bool either
             raise ParameterError(
                 "solver_iterations", self.solver_iterations, "an integer from 1 to 200"
             )
