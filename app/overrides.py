@@ -54,6 +54,7 @@ DESCRIPTION_FIELDS = {
     "fall_tilt": "float",
     "swing_height": "float",
     "ground_friction": "float",
+    "sole_spinning_friction": "float",
     "stride_length": "float",
     "step_width": "float",
     "double_support_duration": "float",

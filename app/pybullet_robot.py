@@ -69,7 +69,11 @@ class SimulatedRobot:
         }
         for link in self.foot_links.values():
             client.changeDynamics(
-                self.body, link, lateralFriction=description.ground_friction, frictionAnchor=1
+                self.body,
+                link,
+                lateralFriction=description.ground_friction,
+                spinningFriction=description.sole_spinning_friction,
+                frictionAnchor=1,
             )
         self.link_count = client.getNumJoints(self.body)
         self.link_masses = np.array(
@@ -216,6 +220,11 @@ class SimulatedRobot:
         (``forward_kinematics``: see :meth:`_foot_frame`)."""
         origin, rotation = self._foot_frame(foot, forward_kinematics)
         return origin + rotation @ np.array(self.description.sole_offset)
+
+    def sole_frame(self, foot: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World position [m] and rotation of ``foot``'s sole frame (forward kinematics first)."""
+        origin, rotation = self._foot_frame(foot, True)
+        return origin + rotation @ np.array(self.description.sole_offset), rotation
 
     def sole_yaw(self, foot: str) -> float:
         """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""

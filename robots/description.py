@@ -89,6 +89,10 @@ class RobotDescription:
         fall_tilt: Pelvis tilt from vertical [rad] over which it counts as fallen.
         swing_height: Apex height of the swing sole above the ground [m].
         ground_friction: Lateral friction coefficient of the ground and soles [-].
+        sole_spinning_friction: PyBullet's torsional friction of the soles [m]: each
+            contact point resists a turn about the ground normal with up to this
+            times its normal force (a contact patch of radius a gives about
+            2/3 mu a); 0: point contacts, which resist no turn.
         stride_length: Nominal L_x of the planner's gait [m].
         step_width: Nominal L_y [m].
         double_support_duration: Nominal T_DSP [s].
@@ -135,6 +139,7 @@ class RobotDescription:
     fall_tilt: float = math.radians(45.0)
     swing_height: float = 0.06
     ground_friction: float = 1.0
+    sole_spinning_friction: float = 0.0
     stride_length: float = 0.1
     step_width: float = 0.2
     double_support_duration: float = 0.1
@@ -176,6 +181,10 @@ class RobotDescription:
             raise ParameterError("swing_height", self.swing_height, "0 < h < 0.3 m")
         if not self.ground_friction > 0.0:
             raise ParameterError("ground_friction", self.ground_friction, "> 0")
+        if not 0.0 <= self.sole_spinning_friction <= 0.1:
+            raise ParameterError(
+                "sole_spinning_friction", self.sole_spinning_friction, "in [0, 0.1] m"
+            )
         iterations = self.solver_iterations
         if type(iterations) is not int or not 1 <= iterations <= 200:  # not a bool either
             raise ParameterError(

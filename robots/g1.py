@@ -122,6 +122,17 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   with 3 N m; 10 N s at mid single support is recovered in 7 of 8 directions against 5
   (4, 4.5, 5.5 and 6 N m: 5, 7, 7 and 5 of 8). The 20 s walk is unchanged (no
   adjusted step, V_u peak 0.35 gamma_v).
+* ``sole_spinning_friction`` 0.01 m: PyBullet's box-on-plane contact touches the sole
+  at its corners only, and point contacts resist no turn about the ground normal, so a
+  sole standing on one corner (the CoP on a sole corner after a push) spins freely: after
+  the second ``paper-fig6`` push the stance soles turned by 10-20 deg within one single
+  support. A rubber sole touches over an area: torsional friction of 0.01 m per contact
+  point (about 2/3 mu a for a patch of radius a = 1.5 cm) models it. On the 64 pushes at
+  phases 0.5625 and 0.25 (``rsg grid --controllers rsg --phases 0.5625,0.25``) rsg is
+  not fallen after 31 (31 recovered) and 21 (21) of 32 against 28 (28) and 19 (19) with
+  point contacts (``--set sole_spinning_friction=0``), and 10 N s at mid single support
+  is recovered in all 8 directions against 7; 0.02 m gave 29 (29) and 21 (21), 6 of 8.
+  The 20 s walk is unchanged (README, "Torsional friction under the soles").
 * ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
   30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
   toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's
@@ -218,6 +229,7 @@ G1 = RobotDescription(
     fall_base_height=0.45,
     swing_height=0.06,
     sole_box_collision=True,
+    sole_spinning_friction=0.01,
     upper_body_joints=(
         "waist_yaw_joint",
         "waist_roll_joint",

@@ -122,6 +122,8 @@ def test_strong_push_without_stepping_is_detected_as_a_fall(backend):
         {"swing_feedback": 1.5},
         {"swing_feedback": -0.1},
         {"swing_feedback_filter": 0.0},
+        {"swing_level_feedback": 1.5},
+        {"swing_level_feedback": -0.1},
     ],
 )
 def test_walking_options_are_validated(options):
@@ -259,6 +261,50 @@ def test_swing_feedback_keeps_the_real_swing_sole_on_its_trajectory_under_a_push
         else:
             assert error < 0.002
             assert 0.003 < np.linalg.norm(backend._swing_offset) <= SWING_FEEDBACK_LIMIT
+    finally:
+        backend.close()
+
+
+@pytest.mark.parametrize("gain", [0.0, 1.0])
+def test_swing_level_feedback_keeps_the_swing_sole_at_its_height_and_flat_under_a_push(gain):
+    """40 N toward the swing side during the swing rolls G1 over its stance foot: without
+    feedback the real swing sole's lowest corner comes down to 5 mm where the swing
+    profile is at 34 mm (an early touchdown) and the sole tilts by 6.6 deg; with
+    ``swing_level_feedback`` 1 it stays within 7 mm of the profile and within 1.5 deg
+    of flat (measured). The IK's swing sole is raised by the filtered sag."""
+    backend = PyBulletBackend("g1", swing_level_feedback=gain)
+    try:
+        over_left = LEFT.position.copy()
+        backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+        planned: list[np.ndarray] = []
+        update = backend.swing.update
+
+        def recorded(*args):
+            planned.append(update(*args).copy())
+            return planned[-1].copy()
+
+        backend.swing.update = recorded
+        target = Foothold("right", np.array([0.1, -0.13]))
+        height_errors, tilts = [], []
+        for tick in range(round(0.62 / backend.control_period)):
+            time = tick * backend.control_period
+            push = np.array([0.0, -40.0]) if 0.2 < time < 0.7 else np.zeros(2)
+            backend.step(command(time, over_left, next_step=target, since_step=time), push)
+            if time > 0.1:  # single support
+                ik = backend.ik.sole_world("right")[2, 3]
+                raised = max(planned[-1][2], backend.landing_clearance) + gain * backend._swing_sag
+                assert ik == pytest.approx(raised, abs=5e-4)
+                origin, rotation = backend.sim.sole_frame("right")
+                lowest = origin[2] + np.min(rotation[2] @ backend._sole_corners.T)
+                height_errors.append(abs(lowest - planned[-1][2]))
+                tilts.append(np.degrees(np.arccos(min(rotation[2, 2], 1.0))))
+        assert not backend.fall_status().fell
+        if gain == 0.0:
+            assert max(height_errors) > 0.02 and tilts[-1] > 5.0
+            assert backend._swing_sag == 0.0
+        else:
+            assert max(height_errors) < 0.01 and max(tilts) < 2.0
+            assert backend._swing_sag > 0.01
     finally:
         backend.close()
 

@@ -38,6 +38,29 @@ def test_description_validates_its_fields():
         dataclasses.replace(g1, left_ankle_link=g1.right_ankle_link)
 
 
+@pytest.mark.parametrize("value", [-0.01, 0.2, float("nan")])
+def test_sole_spinning_friction_is_validated(value):
+    with pytest.raises(ParameterError) as error:
+        dataclasses.replace(get_robot("g1"), sole_spinning_friction=value)
+    assert error.value.field == "sole_spinning_friction"
+
+
+@pytest.mark.parametrize("value", [0.0, 0.01])
+def test_soles_get_their_torsional_friction_in_pybullet(value):
+    """The soles' spinning friction reaches PyBullet; the other links keep none."""
+    from app.pybullet_robot import SimulatedRobot
+
+    robot = SimulatedRobot(dataclasses.replace(get_robot("g1"), sole_spinning_friction=value))
+    try:
+        dynamics = robot.client.getDynamicsInfo
+        for link in robot.foot_links.values():
+            assert dynamics(robot.body, link)[7] == pytest.approx(value)
+        others = set(range(robot.link_count)) - set(robot.foot_links.values())
+        assert all(dynamics(robot.body, link)[7] == 0.0 for link in others)
+    finally:
+        robot.close()
+
+
 def test_derived_urdf_is_reproducible_and_has_the_frames(tmp_path):
     g1 = get_robot("g1")
     path = derived_urdf(g1)
