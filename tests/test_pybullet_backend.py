@@ -225,6 +225,29 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     assert not backend.fall_status().fell
 
 
+def pushed_swing(backend, lateral_force, seconds):
+    """Step a right-foot swing from LEFT toward (0.1, -0.13) m with ``lateral_force`` [N]
+    on the pelvis from 0.2 to 0.7 s; yield (time [s], swing profile's sole position [m])
+    after each tick of single support."""
+    over_left = LEFT.position.copy()
+    backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
+    planned: list[np.ndarray] = []
+    update = backend.swing.update
+
+    def recorded(*args):
+        planned.append(update(*args).copy())
+        return planned[-1].copy()
+
+    backend.swing.update = recorded
+    target = Foothold("right", np.array([0.1, -0.13]))
+    for tick in range(round(seconds / backend.control_period)):
+        time = tick * backend.control_period
+        push = np.array([0.0, lateral_force]) if 0.2 < time < 0.7 else np.zeros(2)
+        backend.step(command(time, over_left, next_step=target, since_step=time), push)
+        if time > 0.1:  # single support
+            yield time, planned[-1]
+
+
 @pytest.mark.parametrize("gain", [0.0, 1.0])
 def test_swing_feedback_keeps_the_real_swing_sole_on_its_trajectory_under_a_push(gain):
     """40 N sideways on the pelvis during the swing tilts G1 on its stance leg: without
@@ -233,28 +256,13 @@ def test_swing_feedback_keeps_the_real_swing_sole_on_its_trajectory_under_a_push
     IK's swing sole is the trajectory's minus the filtered offset."""
     backend = PyBulletBackend("g1", swing_feedback=gain)
     try:
-        over_left = LEFT.position.copy()
-        backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
-        planned: list[np.ndarray] = []
-        update = backend.swing.update
-
-        def recorded(*args):
-            planned.append(update(*args).copy())
-            return planned[-1].copy()
-
-        backend.swing.update = recorded
-        target = Foothold("right", np.array([0.1, -0.13]))
-        for tick in range(78):
-            time = tick * backend.control_period
-            push = np.array([0.0, 40.0]) if 0.2 < time < 0.7 else np.zeros(2)
-            backend.step(command(time, over_left, next_step=target, since_step=time), push)
-            if time > 0.1:  # single support
-                ik = backend.ik.sole_world("right")[:2, 3]
-                shifted = planned[-1][:2] - gain * backend._swing_offset
-                np.testing.assert_allclose(ik, shifted, atol=5e-4)
+        for _, planned in pushed_swing(backend, 40.0, 0.78):
+            ik = backend.ik.sole_world("right")[:2, 3]
+            shifted = planned[:2] - gain * backend._swing_offset
+            np.testing.assert_allclose(ik, shifted, atol=5e-4)
         assert not backend.fall_status().fell
         real = backend.sim.sole_position("right")[:2] - backend.sim.sole_position("left")[:2]
-        error = float(np.linalg.norm(real - (planned[-1][:2] - LEFT.position)))
+        error = float(np.linalg.norm(real - (planned[:2] - LEFT.position)))
         if gain == 0.0:
             assert error > 0.004
             assert not backend._swing_offset.any()
@@ -274,30 +282,15 @@ def test_swing_level_feedback_keeps_the_swing_sole_at_its_height_and_flat_under_
     of flat (measured). The IK's swing sole is raised by the filtered sag."""
     backend = PyBulletBackend("g1", swing_level_feedback=gain)
     try:
-        over_left = LEFT.position.copy()
-        backend.reset(InitialCondition(LEFT, RIGHT, over_left, np.zeros(2)))
-        planned: list[np.ndarray] = []
-        update = backend.swing.update
-
-        def recorded(*args):
-            planned.append(update(*args).copy())
-            return planned[-1].copy()
-
-        backend.swing.update = recorded
-        target = Foothold("right", np.array([0.1, -0.13]))
         height_errors, tilts = [], []
-        for tick in range(round(0.62 / backend.control_period)):
-            time = tick * backend.control_period
-            push = np.array([0.0, -40.0]) if 0.2 < time < 0.7 else np.zeros(2)
-            backend.step(command(time, over_left, next_step=target, since_step=time), push)
-            if time > 0.1:  # single support
-                ik = backend.ik.sole_world("right")[2, 3]
-                raised = max(planned[-1][2], backend.landing_clearance) + gain * backend._swing_sag
-                assert ik == pytest.approx(raised, abs=5e-4)
-                origin, rotation = backend.sim.sole_frame("right")
-                lowest = origin[2] + np.min(rotation[2] @ backend._sole_corners.T)
-                height_errors.append(abs(lowest - planned[-1][2]))
-                tilts.append(np.degrees(np.arccos(min(rotation[2, 2], 1.0))))
+        for _, planned in pushed_swing(backend, -40.0, 0.62):
+            ik = backend.ik.sole_world("right")[2, 3]
+            raised = max(planned[2], backend.landing_clearance) + gain * backend._swing_sag
+            assert ik == pytest.approx(raised, abs=5e-4)
+            origin, rotation = backend.sim.sole_frame("right")
+            lowest = origin[2] + np.min(rotation[2] @ backend._sole_corners.T)
+            height_errors.append(abs(lowest - planned[2]))
+            tilts.append(np.degrees(np.arccos(min(rotation[2, 2], 1.0))))
         assert not backend.fall_status().fell
         if gain == 0.0:
             assert max(height_errors) > 0.02 and tilts[-1] > 5.0
