@@ -73,6 +73,10 @@ def main(args: argparse.Namespace) -> int:
     server = viser.ViserServer(host=args.host, port=args.port, label="rsg demo", verbose=False)
     page: DemoPage | None = None
     if threading.current_thread() is threading.main_thread():
+        # SIGINT explicitly too: a process started as a background job of a
+        # non-interactive shell inherits SIGINT ignored, and Python then raises no
+        # KeyboardInterrupt (measured: CI started that way killed the demos after 30 s).
+        signal.signal(signal.SIGINT, _interrupt)
         signal.signal(signal.SIGTERM, _interrupt)
     try:
         if server.get_port() != args.port:
