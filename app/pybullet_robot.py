@@ -215,16 +215,17 @@ class SimulatedRobot:
         rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
         return np.array(state[4]), rotation
 
-    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
-        """World position [m] of the sole frame origin of ``foot``, shape (3,)
+    def sole_frame(
+        self, foot: str, forward_kinematics: bool = True
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World position [m] and rotation of ``foot``'s sole frame
         (``forward_kinematics``: see :meth:`_foot_frame`)."""
         origin, rotation = self._foot_frame(foot, forward_kinematics)
-        return origin + rotation @ np.array(self.description.sole_offset)
-
-    def sole_frame(self, foot: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """World position [m] and rotation of ``foot``'s sole frame (forward kinematics first)."""
-        origin, rotation = self._foot_frame(foot, True)
         return origin + rotation @ np.array(self.description.sole_offset), rotation
+
+    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
+        """World position [m] of the sole frame origin of ``foot``, shape (3,)."""
+        return self.sole_frame(foot, forward_kinematics)[0]
 
     def sole_yaw(self, foot: str) -> float:
         """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
