@@ -58,6 +58,7 @@ def summary_of(result: RunResult, controller: str) -> dict:
             "swing_preparation_time": config.rsg.swing_preparation_time,
             "step_reaction_time": config.rsg.step_reaction_time,
             "push_hold_time": config.rsg.push_hold_time,
+            "dcm_inset": config.rsg.dcm_inset,
             "com_reach": None
             if math.isinf(config.constraints.com_reach)
             else config.constraints.com_reach,

@@ -28,10 +28,11 @@ def resolve_robot(model: str, robot: str | None) -> str | None:
 def paper_rules(config: PlannerConfig) -> PlannerConfig:
     """``config`` without the documented extensions: the paper's D_T and (27) as printed
     (no push hold, ``push_hold_time = 0``; no step reaction time,
-    ``step_reaction_time = 0``; no leg reach in the QP, ``com_reach = inf``)."""
+    ``step_reaction_time = 0``; no leg reach in the QP, ``com_reach = inf``; no DCM
+    row (27c'), ``dcm_inset = None``)."""
     return replace(
         config,
-        rsg=replace(config.rsg, push_hold_time=0.0, step_reaction_time=0.0),
+        rsg=replace(config.rsg, push_hold_time=0.0, step_reaction_time=0.0, dcm_inset=None),
         constraints=replace(config.constraints, com_reach=math.inf),
     )
 

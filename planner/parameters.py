@@ -193,6 +193,10 @@ class RsgParameters:
             |f| c_z / (m g) it causes [m], above which a push counts as under way.
         reanchor_time: Time constant [s] with which o_H moves to a measured stance
             sole (``MeasuredState.stance_sole``); 0: at once.
+        dcm_inset: An extension of (27c) to the DCM [m]: a QP step puts the new stance
+            sole's centre line at least this far outside the DCM predicted at the
+            step, sigma+ (xi_dcm,y - u_d,y) <= -dcm_inset (see
+            :mod:`planner.step_qp`); None (the paper): no such row.
     """
 
     filter_time_constant: float = 0.05
@@ -208,8 +212,11 @@ class RsgParameters:
     push_hold_time: float = 0.15
     push_cmp_threshold: float = 0.02
     reanchor_time: float = 0.0
+    dcm_inset: float | None = None
 
     def __post_init__(self) -> None:
+        if self.dcm_inset is not None:
+            _check_range("dcm_inset", self.dcm_inset, -0.1, 0.1)
         _check_range("step_reaction_time", self.step_reaction_time, 0.0, 1.0)
         _check_range("push_hold_time", self.push_hold_time, 0.0, 1.0)
         _check_range("reanchor_time", self.reanchor_time, 0.0, 1.0)

@@ -239,7 +239,7 @@ class ReactiveStepGenerator:
 
     def _step_location(
         self,
-        xi1: np.ndarray,
+        xi: np.ndarray,
         error: np.ndarray,
         level: float,
         solver: str,
@@ -248,18 +248,20 @@ class ReactiveStepGenerator:
         """u_d of the output map H_nu; returns (u_d, from_qp, qp_feasible).
 
         The QP is used while V_u >= gamma_v and for a scheduled timing jump;
-        ``reference_xi1`` is xi1* at the step (default: now).
+        ``xi`` is the state (c_H - o_H, cdot_H) at the step and ``reference_xi1``
+        xi1* then (default: now).
         """
         use_qp = level >= self.design.threshold or self.scheduled_step is not None
         if self.config.adjusts_location and use_qp:
             problem = build_step_qp(
                 self.design.matrix,
                 error,
-                xi1,
+                xi[:2],
                 self.reference.xi1 if reference_xi1 is None else reference_xi1,
                 self.sigma,
                 self.config.constraints,
                 self.config.rsg,
+                dcm=xi[:2] + xi[2:] / self.omega,
             )
             solution = solve_step_qp(problem, solver)
             return solution.step, True, solution.feasible
@@ -294,11 +296,11 @@ class ReactiveStepGenerator:
             delay = self.scheduled_step - self.time_since_step
             predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
             step, _, _ = self._step_location(
-                predicted[:2], predicted_error, level, "exact", reference_xi1
+                predicted, predicted_error, level, "exact", reference_xi1
             )
             return self.stance + step
         if self.config.adjusts_location and level >= self.design.threshold:
-            step, _, _ = self._step_location(xi[:2], error, level, "exact")
+            step, _, _ = self._step_location(xi, error, level, "exact")
             return self.stance + step
         wait = self._nominal_wait() if nominal_wait is None else nominal_wait
         future = flow_autonomous(self.omega, self.reference.state, wait)
@@ -362,7 +364,7 @@ class ReactiveStepGenerator:
                 # The swing foot was sent to the foothold announced last tick: it lands there.
                 u_d, from_qp, feasible = self.announced_step - self.stance, True, True
             else:
-                u_d, from_qp, feasible = self._step_location(xi[:2], error, level, self.qp_solver)
+                u_d, from_qp, feasible = self._step_location(xi, error, level, self.qp_solver)
             qp_infeasible = not feasible
             window_now = self.stance + self.window_offset()
             self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)

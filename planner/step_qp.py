@@ -24,6 +24,20 @@ box optimum is kept when it meets it, otherwise the optimum lies on the reach ci
 inside the box (:func:`_solve_on_reach_circle`). If no allowed step meets the reach,
 the box optimum is kept.
 
+DCM inset (an extension, ``RsgParameters.dcm_inset``; None gives (27c) as printed):
+(27c) keeps the CoM inside the new sole, but what the stance can hold is the DCM. A
+sole about 5 cm wide holds a lateral DCM error of only a few centimetres, and the
+no-crossing rule (27b) keeps the next foot from stepping back across to catch one
+that leaves it outwards, so the row (27c) also bounds the DCM predicted at the step,
+xi_dcm = xi1 + xi2 / omega (relative to the old stance):
+
+    sigma+ (xi_dcm,y - u_d,y) <= -dcm_inset                                  (27c')
+
+(the new sole's centre line at least ``dcm_inset`` outside the DCM). Both bound
+sigma+ u_d,y from below, so the row keeps the tighter bound; the DCM part never asks
+for more than the largest lateral step (27d) allows, so it never makes (27) infeasible
+on its own: beyond that it is the largest step outwards.
+
 Infeasibility: (27b)-(27d) reduce to a box on u_d. (27c) can make it empty when the
 CoM is already beyond where the largest lateral step can reach. The documented
 fallback is then to drop (27c) and take the step that minimises V_u within (27b),
@@ -139,6 +153,7 @@ def build_step_qp(
     sigma: int,
     constraints: Constraints,
     params: RsgParameters,
+    dcm: np.ndarray | None = None,
 ) -> StepQpProblem:
     """Problem (27) at the current state.
 
@@ -149,20 +164,30 @@ def build_step_qp(
         xi1_reference: xi1* before the step [m].
         sigma: Current stance foot (+1 left, -1 right); the new one is -sigma.
         constraints: Bounds w_y, u_d^m, u_d^M.
-        params: Margins mu_2, mu_3.
+        params: Margins mu_2, mu_3 and the DCM inset of (27c').
+        dcm: xi_dcm - o_H before the step [m], for (27c') (needed when
+            ``params.dcm_inset`` is set).
     """
     sigma_new = -sigma
     w_y = constraints.half_width
+    com_bound = w_y - params.com_margin - sigma_new * float(xi1[1])
+    if params.dcm_inset is not None:
+        if dcm is None:
+            raise StepQpError("dcm_inset is set: the QP needs the DCM before the step", None)
+        # The largest step outwards (27d) allows: sigma+ u_y <= outward.
+        outward = constraints.step_max[1] if sigma_new > 0 else -constraints.step_min[1]
+        dcm_bound = -params.dcm_inset - sigma_new * float(dcm[1])
+        com_bound = min(com_bound, max(dcm_bound, -outward))
     g = np.array(
         [
             [0.0, -sigma_new],  # (27b): -sigma+ u_y <= -(2 w_y + mu_2)
-            [0.0, -sigma_new],  # (27c): -sigma+ u_y <= w_y - mu_3 - sigma+ xi1_y
+            [0.0, -sigma_new],  # (27c): -sigma+ u_y <= w_y - mu_3 - sigma+ xi1_y, (27c')
         ]
     )
     h = np.array(
         [
             -(2.0 * w_y + params.crossing_margin),
-            w_y - params.com_margin - sigma_new * float(xi1[1]),
+            com_bound,
         ]
     )
     return StepQpProblem(

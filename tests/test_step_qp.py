@@ -6,6 +6,7 @@ import math
 import numpy as np
 import pytest
 
+from planner.exceptions import ParameterError, StepQpError
 from planner.lyapunov import design_lyapunov
 from planner.parameters import Constraints, LipmModel, RsgParameters
 from planner.step_qp import build_step_qp, solve_box_exact, solve_step_qp
@@ -156,3 +157,41 @@ def test_leg_reach_keeps_the_com_within_reach_of_the_new_foot():
     off = Constraints(com_reach=math.inf)
     paper = build_step_qp(P_U, error, xi1, reference, -1, off, PARAMS)
     np.testing.assert_allclose(solve_step_qp(paper, "exact").step, box_only, atol=1e-12)
+
+
+@pytest.mark.parametrize("sigma", [1, -1])
+def test_dcm_inset_puts_the_new_sole_outside_the_predicted_dcm(sigma):
+    """(27c'): with ``dcm_inset`` the step leaves the DCM at least that far inside the
+    new sole's centre line (towards the old foot), which the V_u-optimal step of (27)
+    does not; where the box cannot get that far it is the largest step outwards."""
+    sigma_new = -sigma
+    xi1 = np.array([0.05, -sigma * 0.08])  # the CoM over the stance leg's inner side
+    dcm = xi1 + np.array([0.05, sigma_new * 0.18])  # moving fast towards the swing side
+    reference = np.array([0.05, -sigma * 0.09])
+    error = np.array([0.0, sigma_new * 0.03])
+    inset = 0.03
+    plain = solve_step_qp(build_step_qp(P_U, error, xi1, reference, sigma, CONSTRAINTS, PARAMS))
+    assert sigma_new * (dcm[1] - plain.step[1]) > -inset  # (27) alone leaves it closer
+    params = RsgParameters(dcm_inset=inset)
+    problem = build_step_qp(P_U, error, xi1, reference, sigma, CONSTRAINTS, params, dcm=dcm)
+    for solver in ("exact", "proxqp"):
+        solution = solve_step_qp(problem, solver)
+        assert solution.feasible
+        assert sigma_new * (dcm[1] - solution.step[1]) == pytest.approx(-inset, abs=1e-6)
+        assert problem.max_violation(solution.step) < 1e-6
+        assert solution.lyapunov_after > plain.lyapunov_after  # paid for in V_u
+    # A DCM beyond the largest step: the largest step outwards, still feasible.
+    far = xi1 + np.array([0.0, sigma_new * 1.0])
+    problem = build_step_qp(P_U, error, xi1, reference, sigma, CONSTRAINTS, params, dcm=far)
+    solution = solve_step_qp(problem, "exact")
+    assert solution.feasible
+    outward = CONSTRAINTS.step_max[1] if sigma_new > 0 else CONSTRAINTS.step_min[1]
+    assert solution.step[1] == pytest.approx(outward, abs=1e-9)
+
+
+def test_dcm_inset_needs_the_dcm_and_a_sane_value():
+    params = RsgParameters(dcm_inset=0.02)
+    with pytest.raises(StepQpError, match="DCM"):
+        build_step_qp(P_U, np.zeros(2), np.zeros(2), np.zeros(2), 1, CONSTRAINTS, params)
+    with pytest.raises(ParameterError, match="dcm_inset"):
+        RsgParameters(dcm_inset=0.5)
