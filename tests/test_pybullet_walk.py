@@ -1,14 +1,14 @@
 """The RSG walking the Unitree G1 in PyBullet (slow: full-robot runs).
 
-The walk, push and paper-fig6 tests state the goals of the full-robot backend. Those
-not met yet are marked ``xfail(strict=True)``, so that they start to fail (and the
-marker must go) as soon as they are. Status, measured with the G1 defaults of
-``robots/g1.py``: the 20 s walk is recovered (24 steps, none adjusted, max V_u 0.35
-gamma_v); 10 N s at mid single support is recovered in all 8 directions (7 of 8, not
-135 deg, with point contacts under the soles); paper-fig6 still falls at 6.0 s (an
-adjusted step touches down early, the robot leaves the ground, and the lateral DCM
-error grows beyond the ZMP window before the next step may land); see the README
-("The full robot") and ``rsg run --physics-log``.
+The walk, push and paper-fig6 tests state the goals of the full-robot backend.
+Status, measured with the G1 defaults of ``robots/g1.py``: the 20 s walk is recovered
+(24 steps, none adjusted, max V_u 0.35 gamma_v); 10 N s at mid single support is
+recovered in all 8 directions; paper-fig6 is recovered (16 steps, 4 adjusted, max V_u
+6.3 gamma_v) since a timing jump no longer postpones a step due sooner than the
+reaction time (it fell at 6.0 s before: the step came 0.06 s late, the lateral DCM
+error at the touchdown was more than the 5 cm sole holds). Pushes late in single
+support remain G1's weak spot (README, "The full robot"); see also
+``rsg run --physics-log``.
 """
 
 from __future__ import annotations
@@ -27,7 +27,6 @@ from planner.types import Push
 pytestmark = pytest.mark.slow
 
 LANDING_TOLERANCE = 0.03  # [m] measured sole vs. the planner's step position
-NOT_YET = "G1 paper-fig6 not achieved yet: falls 2.2 s after the first push"
 
 
 @pytest.fixture(autouse=True)
@@ -147,8 +146,9 @@ def test_the_ankle_cop_feedback_brings_the_measured_cop_to_the_plan():
     assert with_loop < 0.7 * without
 
 
-@pytest.mark.xfail(strict=True, reason=NOT_YET)
 def test_g1_recovers_paper_fig6_with_an_adjusted_step():
+    """The paper's two pushes, scaled by the mass ratio (5.6 N s each; the first late in
+    a left single support): recovered, with adjusted steps after the first push."""
     scenario = BUILT_IN["paper-fig6"]
     result, _ = run_g1(scenario)
     assert result.recovered, result.fall.reason

@@ -274,6 +274,25 @@ def test_step_reaction_time_schedules_the_step_and_lands_where_announced():
     assert drift[-1] < 1e-3 and drift[-1] <= drift[0]
 
 
+def test_a_timing_jump_never_postpones_the_nominal_step():
+    """A push 0.1 s before a nominal touchdown with a 0.2 s reaction time: D_T fires,
+    and the step still comes at the nominal time (not 0.2 s after the decision), with
+    the QP's foothold, and that time is what was announced."""
+    reaction = 0.2
+    config = _reaction_config(reaction)
+    quiet, _ = _walk_with_push(config, 10.0, np.zeros(2), 0.1, 3.2)
+    nominal = [o.step.time for o in quiet if o.step is not None and o.time > 1.5][0]
+    push = nominal - 0.1
+    outputs, _ = _walk_with_push(config, push, np.array([0.0, 900.0]), 0.05, 3.2)
+    index = next(k for k, o in enumerate(outputs) if o.time >= push and o.step is not None)
+    step = outputs[index].step
+    assert step.time == pytest.approx(nominal, abs=2e-3)
+    assert step.location_adjusted
+    decided = [o for o in outputs[index - 100 : index] if o.lyapunov >= 0.0015]
+    assert decided and decided[0].time < nominal - 0.03  # decided with < 0.2 s to go
+    assert outputs[index - 1].next_step_time == pytest.approx(step.time, abs=2e-3)
+
+
 def test_step_reaction_time_recovers_what_the_instant_step_recovers():
     """On the LIPM a 0.1 s reaction time still recovers paper-fig6 scaled x2."""
     from app.lipm_backend import LipmBackend
