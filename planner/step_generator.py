@@ -58,7 +58,7 @@ reference's own (gated) step: a timing jump brings a step forward and never post
 it (without the cap, a push late in the single support, with the nominal touchdown
 less than Delta away, delayed the step by up to Delta; on G1 32 pushes at phases 0.8
 and 0.9, `rsg grid --controllers rsg --phases 0.8,0.9 --impulses 4,6 --settle 5`, were
-not fallen after 11 with the delay and 20 without). The decision is kept (even if
+not fallen after 11 with the delay and 21 without). The decision is kept (even if
 V_u dips below gamma_v meanwhile, else the announced foothold flips between the
 QP's and the nominal one as V_u crosses gamma_v), ``next_step_time`` announces
 s~_td, and ``next_step`` is the QP (27) solved at the state predicted at s~_td (the
