@@ -277,7 +277,7 @@ class ReactiveStepGenerator:
                 self.sigma,
                 self.config.constraints,
                 self.config.rsg,
-                dcm=xi[:2] + xi[2:] / self.omega,
+                dcm=dcm(self.omega, xi),
             )
             solution = solve_step_qp(problem, solver)
             return solution.step, True, solution.feasible
