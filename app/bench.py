@@ -40,6 +40,8 @@ from planner.parameters import PlannerConfig
 from planner.step_qp import build_step_qp, solve_step_qp
 
 from .lipm_backend import LipmBackend
+from .overrides import Overrides, add_set_argument
+from .robot_setup import check_robot_overrides
 from .runner import ClosedLoop
 from .scenarios import BUILT_IN, Scenario
 
@@ -127,21 +129,24 @@ def bench_step_qp(samples: int = 500, seed: int = 0) -> dict:
     }
 
 
-def bench_robot(robot: str, duration: float, controller: str = "rsg") -> dict:
+def bench_robot(
+    robot: str, duration: float, controller: str = "rsg", overrides: Overrides = ()
+) -> dict:
     """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then).
 
     With ``controller="placo-wpg"`` the planner is the placo baseline, and its
     ticks are timed too (``rsg_tick``/``rsg_step_tick`` keys: without/with a step).
+    ``overrides``: ``--set`` assignments (for example ``locked_joints=none``).
     """
     planner = None
     if controller == "placo-wpg":
         from .placo_wpg import build_placo_wpg_backend
 
-        backend, config, initial, planner = build_placo_wpg_backend(robot)
+        backend, config, initial, planner = build_placo_wpg_backend(robot, overrides)
     else:
         from .setup import build_backend
 
-        backend, config, initial = build_backend("pybullet", robot, controller)
+        backend, config, initial = build_backend("pybullet", robot, controller, overrides=overrides)
     ik_times: list[float] = []
     physics_times: list[float] = []
     tick_times: list[float] = []
@@ -173,6 +178,7 @@ def bench_robot(robot: str, duration: float, controller: str = "rsg") -> dict:
         fall = backend.fall_status()
         ticks = max(getattr(backend, "ticks", 1), 1)
         timers = {k: v / ticks for k, v in getattr(backend, "timers", {}).items()}
+        motors = len(backend.sim.joint_names)
     finally:
         backend.close()
     planner_ticks = {"rsg_tick": stats(flow), "rsg_step_tick": stats(jump)}
@@ -188,12 +194,13 @@ def bench_robot(robot: str, duration: float, controller: str = "rsg") -> dict:
         "fall_reason": fall.reason,
         "backend_timers_mean_per_tick": timers,
         "control_period": loop.period,
+        "motors": motors,
     }
 
 
-def bench_placo_wpg(robot: str, duration: float) -> dict:
+def bench_placo_wpg(robot: str, duration: float, overrides: Overrides = ()) -> dict:
     """The same figures for the placo-wpg baseline (its planner ticks on the robot)."""
-    return bench_robot(robot, duration, "placo-wpg")
+    return bench_robot(robot, duration, "placo-wpg", overrides)
 
 
 ROWS = (
@@ -250,6 +257,7 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--duration", type=float, default=4.0, help="full-robot walk [s] (4)")
     p.add_argument("--samples", type=int, default=1000, help="sampled step QPs (1000)")
     p.add_argument("--no-robot", action="store_true", help="skip the PyBullet part")
+    add_set_argument(p)
     p.add_argument("--out", type=Path, required=True, help="folder for bench.json")
 
 
@@ -259,12 +267,17 @@ def bench_command(args: argparse.Namespace) -> int:
         raise ParameterError("--duration", args.duration, "seconds in [0.05, 600]")
     if not 10 <= args.samples <= 1_000_000:
         raise ParameterError("--samples", args.samples, "an integer in [10, 1000000]")
-    report: dict = {"units": "seconds per call; real_time_factor = simulated / wall time"}
+    overrides = tuple(args.overrides)
+    check_robot_overrides(args.robot, overrides)
+    report: dict = {
+        "units": "seconds per call; real_time_factor = simulated / wall time",
+        "overrides": [f"{name}={value}" for name, value in overrides],
+    }
     report.update(bench_rsg_ticks())
     report.update(bench_step_qp(args.samples))
     if not args.no_robot:
-        report.update(bench_robot(args.robot, args.duration))
-        report["placo_wpg"] = bench_placo_wpg(args.robot, args.duration)
+        report.update(bench_robot(args.robot, args.duration, overrides=overrides))
+        report["placo_wpg"] = bench_placo_wpg(args.robot, args.duration, overrides)
     table = format_bench(report)
     report["table"] = table
     try:

@@ -23,7 +23,8 @@ RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
 (``cop_feedback=0,2``), ``none`` where the option allows it, or a word for a
-string option (``plan_angular_momentum=feedback``). Ranges are checked where the
+string option (``plan_angular_momentum=feedback``), or comma-separated joint names
+(``locked_joints=none`` actuates every joint). Ranges are checked where the
 parameter is used (the description, the backend, the planner), each with an error
 that names it.
 """
@@ -45,8 +46,8 @@ from robots.description import RobotDescription
 Overrides = tuple[tuple[str, str], ...]
 
 #: Description fields that may be set: the numbers of the gait, the planner's bounds
-#: and timing, the fall thresholds and PyBullet's solver iterations (not the URDF,
-#: links, sole or gains).
+#: and timing, the fall thresholds, PyBullet's solver iterations and the locked
+#: joints (comma-separated names, or ``none``; not the URDF, links, sole or gains).
 DESCRIPTION_FIELDS = {
     "com_height": "float",
     "foot_spacing": "float",
@@ -67,7 +68,9 @@ DESCRIPTION_FIELDS = {
     "filter_time_constant": "float",
     "step_reaction_time": "float",
     "reanchor_time": "float",
+    "dcm_inset": "float | None",
     "solver_iterations": "int",
+    "locked_joints": "names",
 }
 
 #: Backend keyword arguments that are not options of a run.
@@ -164,6 +167,13 @@ def parse_value(name: str, text: str, kind: str) -> Any:
         if lowered in ("false", "0", "no", "off"):
             return False
         raise ParameterError(f"--set {name}", text, "true or false")
+    if "names" in options:  # comma-separated joint names; none: an empty tuple
+        if lowered == "none":
+            return ()
+        names = tuple(part.strip() for part in text.split(","))
+        if not all(names):
+            raise ParameterError(f"--set {name}", text, "comma-separated names, or none")
+        return names
     if "str" in options:
         return text
     if "int" in options:

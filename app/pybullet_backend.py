@@ -900,9 +900,14 @@ class PyBulletBackend:
         return self.sim.feet_in_contact()
 
     def robot_configuration(self) -> tuple[NDArray[np.float64], NDArray[np.float64], dict]:
-        """URDF base position [m], quaternion (x, y, z, w) and joint angles [rad]."""
+        """URDF base position [m], quaternion (x, y, z, w) and joint angles [rad]
+        (the description's locked joints at their standing angle)."""
         position, quaternion = self.sim.base_pose()
-        return position, quaternion, self.sim.joint_angles()
+        locked = {
+            name: self.description.standing_posture.get(name, 0.0)
+            for name in self.description.locked_joints
+        }
+        return position, quaternion, {**locked, **self.sim.joint_angles()}
 
     def sole_positions(self) -> dict[str, NDArray[np.float64]]:
         """Measured sole origin of each foot in the world [m], shape (3,)."""

@@ -8,6 +8,8 @@ of the simulation and moves it, once per control tick, so that:
 * the CoM follows the target [m] (soft, high weight);
 * the trunk and the pelvis stay upright with the feet's mean yaw (soft);
 * the joints stay near the standing posture (soft, low weight), within limits;
+* the description's ``locked_joints`` stay at their standing angle (masked: the
+  physics URDF has them welded, :mod:`robots.urdf_merge`);
 * optionally, the centroidal angular momentum follows a target [N m s] (soft);
 * optionally (``upper_body=True``), the description's ``upper_body_joints`` follow
   their standing angles plus offsets given at each solve (soft, the trunk's
@@ -130,6 +132,11 @@ class WholeBodyIK:
             raise ParameterError("standing_posture", sorted(unknown), "joints of the URDF")
         self.solver = placo.KinematicsSolver(self.robot)
         self.solver.mask_fbase(False)
+        not_joints = sorted(set(description.locked_joints) - set(self.joint_names))
+        if not_joints:
+            raise ParameterError("locked_joints", not_joints, "joints of the URDF")
+        for name in description.locked_joints:
+            self.solver.mask_dof(name)
         self.solver.enable_joint_limits(True)
         self.solver.enable_velocity_limits(False)
 

@@ -111,12 +111,20 @@ class RobotDescription:
         reanchor_time: Time constant [s] with which the planner moves its foothold
             to a measured stance sole (``RsgParameters.reanchor_time``; backend
             option ``reanchor_stance``); 0: at once.
+        dcm_inset: The planner's row (27c') [m] (``RsgParameters.dcm_inset``): a QP
+            step puts the new sole's centre line at least this far outside the
+            predicted DCM; None: (27c) as printed.
         solver_iterations: Iterations of PyBullet's contact and joint-motor
             solver per physics step (its cost grows with them; 1 to 200).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         upper_body_joints: Joints that turn the torso and the arms, used to carry
             the planner's angular momentum (backend option ``upper_body_momentum``).
+        locked_joints: Joints welded at their standing angle, in the physics URDF
+            (:func:`robots.urdf_merge.lock_joints`: fewer degrees of freedom and
+            motor rows, so a cheaper physics step) and in the IK (masked); neither
+            actuated nor measured. Not the upper-body or leg joints the controller
+            moves.
         backend_options: Keyword arguments of the PyBullet backend tuned for
             this robot (CoM tracking), see :class:`app.pybullet_backend.PyBulletBackend`.
     """
@@ -152,9 +160,11 @@ class RobotDescription:
     filter_time_constant: float = 0.05
     step_reaction_time: float = 0.0
     reanchor_time: float = 0.0
+    dcm_inset: float | None = None
     solver_iterations: int = 50
     sole_box_collision: bool = False
     upper_body_joints: tuple[str, ...] = ()
+    locked_joints: tuple[str, ...] = ()
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -193,6 +203,19 @@ class RobotDescription:
         for joint, angle in self.standing_posture.items():
             if not math.isfinite(angle):
                 raise ParameterError(f"standing_posture[{joint}]", angle, "a finite angle [rad]")
+        if self.dcm_inset is not None and not (
+            math.isfinite(self.dcm_inset) and -0.1 <= self.dcm_inset <= 0.1
+        ):
+            raise ParameterError("dcm_inset", self.dcm_inset, "None or in [-0.1, 0.1] m")
+        locked = tuple(self.locked_joints)
+        if any(not isinstance(name, str) or not name for name in locked) or len(set(locked)) != len(
+            locked
+        ):
+            raise ParameterError("locked_joints", self.locked_joints, "distinct joint names")
+        moved = sorted(set(locked) & set(self.upper_body_joints))
+        if moved:
+            raise ParameterError("locked_joints", moved, "joints that are not in upper_body_joints")
+        object.__setattr__(self, "locked_joints", locked)
         # Freeze the mappings so the description stays immutable and hashable-safe.
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
         object.__setattr__(self, "joint_gains", MappingProxyType(dict(self.joint_gains)))

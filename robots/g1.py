@@ -133,6 +133,23 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   point contacts (``--set sole_spinning_friction=0``), and 10 N s at mid single support
   is recovered in all 8 directions against 7; 0.02 m gave 29 (29) and 21 (21), 6 of 8.
   The 20 s walk is unchanged (README, "Torsional friction under the soles").
+* ``locked_joints``: the shoulder yaw, elbow and three wrist joints of each arm are
+  welded at their standing angles, in the physics URDF and in the IK (19 actuated
+  joints instead of 29). The upper body's flywheel uses the waist and the shoulders'
+  pitch and roll, so these joints only held their posture, yet each cost the physics a
+  degree of freedom and a motor row of its iterative solver, whose work grows with rows
+  times degrees of freedom: a 1 ms physics step of G1 standing took 0.58 times as long
+  (README, "Locked arm joints"). Behaviour, with
+  ``dcm_inset`` (below), against all joints actuated without it: not fallen on the 64
+  pushes at phases 0.5625 and 0.25 54 instead of 53, on the 32 late pushes 26 instead of
+  21, 10 N s at mid single support 8 of 8 either way; ``--set locked_joints=none``
+  actuates them again.
+* ``dcm_inset`` 0.02 m (planner row (27c')): a QP step puts the new sole's centre
+  line at least 2 cm outside the predicted DCM. With the arms locked, ``paper-fig6``
+  fell at 6.6 s without it and is recovered with it (15 steps, 2 adjusted), and so
+  are 7 of its 9 variants (pushes shifted by up to 60 ms or scaled by 0.9 and 1.1)
+  against 4 without; the late pushes 26 against 21 (README, "Pushes late in single
+  support").
 * ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
   30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
   toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's
@@ -230,6 +247,11 @@ G1 = RobotDescription(
     swing_height=0.06,
     sole_box_collision=True,
     sole_spinning_friction=0.01,
+    locked_joints=tuple(
+        f"{side}_{joint}_joint"
+        for side in ("left", "right")
+        for joint in ("shoulder_yaw", "elbow", "wrist_roll", "wrist_pitch", "wrist_yaw")
+    ),
     upper_body_joints=(
         "waist_yaw_joint",
         "waist_roll_joint",
@@ -244,6 +266,7 @@ G1 = RobotDescription(
     filter_time_constant=0.01,
     step_reaction_time=0.2,
     reanchor_time=0.2,
+    dcm_inset=0.02,
     backend_options={
         **WALKING_OPTIONS,
         "foothold_feedback": True,

@@ -9,8 +9,9 @@ PyBullet at every touchdown) are replaced by one thin box spanning the sole
 rectangle, bottom face on the sole plane. :func:`derived_urdf` writes a fixed copy to
 ``$RSG_CACHE_DIR/robots/<name>-<hash>/robot.urdf`` (default cache
 ``~/.cache/rsg``); with ``merged=True``, ``robot-merged.urdf``, the same robot
-with the links of fixed joints merged into their parents
-(:mod:`robots.urdf_merge`), for the physics only (the IK needs the frames). The
+with the description's ``locked_joints`` welded at their standing angle and the
+links of fixed joints merged into their parents (:mod:`robots.urdf_merge`), for
+the physics only (the IK needs the frames). The
 hash covers the source text and the derivation settings, so the same input always
 gives the same file, and a new input a new folder.
 """
@@ -26,11 +27,11 @@ from pathlib import Path
 
 from planner.exceptions import ParameterError, RsgError
 from robots.description import RobotDescription
-from robots.urdf_merge import merge_fixed_links
+from robots.urdf_merge import lock_joints, merge_fixed_links
 
 DISTRIBUTION = "example-robot-data"
 PACKAGE_PREFIX = "package://"
-DERIVATION_VERSION = "3"  # bump when the derivation below (or the merge) changes
+DERIVATION_VERSION = "4"  # bump when the derivation below (or the merge) changes
 TINY_MASS = 1e-6  # [kg] mass given to links without <inertial>
 TINY_INERTIA = 1e-9  # [kg m^2]
 FOOT_FRAMES = {"left": "left_foot", "right": "right_foot"}
@@ -155,13 +156,22 @@ def derive_urdf_text(description: RobotDescription, source_text: str, share_dir:
     return ET.tostring(root, encoding="unicode") + "\n"
 
 
+def locked_angles(description: RobotDescription) -> dict[str, float]:
+    """Locked joint -> the angle [rad] it is welded at (its standing angle)."""
+    return {
+        name: float(description.standing_posture.get(name, 0.0))
+        for name in description.locked_joints
+    }
+
+
 def derived_urdf(description: RobotDescription, merged: bool = False) -> Path:
     """Path of the derived URDF of ``description``, created on first use.
 
     Args:
         description: The robot.
-        merged: The variant with fixed-joint links merged into their parents
-            (fewer bodies for the physics; no sole/trunk frames).
+        merged: The variant for the physics: the description's locked joints
+            welded at their standing angle, and fixed-joint links merged into
+            their parents (fewer bodies; no sole/trunk frames).
 
     Raises:
         RobotDataError: The source URDF is not installed.
@@ -176,6 +186,8 @@ def derived_urdf(description: RobotDescription, merged: bool = False) -> Path:
         description.right_ankle_link,
         description.trunk_link,
         repr(tuple(float(v) for v in description.sole_offset)),
+        repr((description.sole, description.sole_box_collision)),
+        repr(locked_angles(description)),
     )
     key = "\n".join((DERIVATION_VERSION, str(share_dir), *settings, source_text))
     digest = hashlib.sha256(key.encode("utf-8")).hexdigest()[:16]
@@ -186,6 +198,7 @@ def derived_urdf(description: RobotDescription, merged: bool = False) -> Path:
     text = derive_urdf_text(description, source_text, share_dir)
     if merged:
         root = ET.fromstring(text)
+        lock_joints(root, locked_angles(description))
         merge_fixed_links(root)
         ET.indent(root, space="  ")
         text = ET.tostring(root, encoding="unicode") + "\n"

@@ -1,5 +1,9 @@
 """Merge the links attached by fixed joints into their parents (a URDF for the physics).
 
+:func:`lock_joints` first turns chosen revolute joints into fixed ones at a given
+angle (the description's ``locked_joints`` at their standing angle), so that the
+merge folds their links into their parents as well.
+
 A fixed joint adds a link to PyBullet's Featherstone tree without a degree of
 freedom, and every link costs time in each physics step (dynamics, and each
 constraint row's response is computed over all the links). G1's derived URDF has
@@ -17,10 +21,13 @@ theorem, and the collision and visual shapes keep their place in the world.
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
+
+from planner.exceptions import ParameterError
 
 Transform = tuple[NDArray[np.float64], NDArray[np.float64]]  # (rotation 3x3, translation [m])
 _INERTIA_ENTRIES = {
@@ -31,6 +38,31 @@ _INERTIA_ENTRIES = {
     "iyz": (1, 2),
     "izz": (2, 2),
 }
+
+
+def lock_joints(root: ET.Element, angles: Mapping[str, float]) -> None:
+    """Make, in place, each joint of ``angles`` a fixed joint at that angle [rad].
+
+    The joint's rotation about its axis is folded into its origin, so the child
+    link keeps the place it had at that angle.
+
+    Raises:
+        ParameterError: A name is not a revolute or continuous joint of the URDF.
+    """
+    joints = {joint.get("name"): joint for joint in root.findall("joint")}
+    for name, angle in angles.items():
+        joint = joints.get(name)
+        if joint is None or joint.get("type") not in ("revolute", "continuous"):
+            raise ParameterError("locked_joints", name, "revolute joints of the URDF")
+        axis_element = joint.find("axis")
+        axis_text = axis_element.get("xyz", "1 0 0") if axis_element is not None else "1 0 0"
+        axis = np.array([float(v) for v in axis_text.split()])
+        turn = Rotation.from_rotvec(angle * axis / np.linalg.norm(axis)).as_matrix()
+        _set_origin(joint, _compose(_origin(joint), (turn, np.zeros(3))))
+        joint.set("type", "fixed")
+        for tag in ("axis", "limit", "dynamics", "mimic", "safety_controller", "calibration"):
+            for element in joint.findall(tag):
+                joint.remove(element)
 
 
 def merge_fixed_links(root: ET.Element) -> None:

@@ -42,6 +42,25 @@ def test_bench_command_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture
     assert "| IK solve |" in format_bench(report)
 
 
+def test_bench_times_the_robot_it_is_given_with_set(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    """``rsg bench --set locked_joints=none`` times G1 with all 29 joints in the
+    physics; the default has the description's locked joints welded (fewer motors);
+    a bad value is an error naming the field before anything runs."""
+    from app.bench import bench_robot
+
+    counts = []
+    for overrides in ((), (("locked_joints", "none"),)):
+        report = bench_robot("g1", 0.05, overrides=overrides)
+        assert report["simulated"] == pytest.approx(0.05) and not report["fell"]
+        counts.append(report["motors"])
+    assert counts == [19, 29]
+    assert main(["bench", "--set", "solver_iterations=0", "--out", str(tmp_path)]) == 2
+    assert "solver_iterations" in capsys.readouterr().err
+    assert not (tmp_path / "bench.json").exists()
+
+
 def test_tick_breakdown_adds_up_the_parts() -> None:
     from app.bench import tick_breakdown
 

@@ -55,6 +55,22 @@ def test_ik_reports_the_angular_momentum_of_its_own_motion(ik):
     assert max(abs(m[1]) for m in momenta) > 0.05  # [N m s]
 
 
+def test_locked_joints_stay_at_their_standing_angle_while_the_others_move(ik):
+    """G1's locked arm joints are welded in the physics; the IK must not move them
+    either (the CoM task would otherwise use the arms)."""
+    g1 = get_robot("g1")
+    locked = [ik.joint_names.index(name) for name in g1.locked_joints]
+    standing = np.array([g1.standing_posture.get(name, 0.0) for name in g1.locked_joints])
+    left, right = sole_pose([0.0, 0.115, 0.0]), sole_pose([0.0, -0.115, 0.0])
+    start = ik.reset(left, right, np.zeros(2))
+    for k in range(1, 31):  # CoM to the left foot while the right one swings forward
+        angles = ik.solve(
+            np.array([0.0, 0.1]), left, sole_pose([0.005 * k, -0.115, 0.04]), "left", DT
+        )
+    assert angles[locked] == pytest.approx(standing, abs=1e-12)
+    assert np.max(np.abs(np.delete(angles - start, locked))) > 0.05  # [rad]: the rest moved
+
+
 def test_ik_rejects_unknown_support(ik):
     with pytest.raises(ParameterError):
         ik.solve(np.zeros(2), np.eye(4), np.eye(4), "none", DT)

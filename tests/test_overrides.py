@@ -31,7 +31,10 @@ def test_values_are_parsed_by_the_kind_of_the_parameter() -> None:
     assert parse_value("x", "off", "bool") is False
     assert parse_value("x", "feedback", "str") == "feedback"
     assert parse_value("x", "30", "int") == 30
+    assert parse_value("x", "a_joint, b_joint", "names") == ("a_joint", "b_joint")
+    assert parse_value("x", "None", "names") == ()
     for text, kind in [
+        ("a_joint,,b_joint", "names"),
         ("a", "float"),
         ("1,2", "float"),
         ("nan", "float"),
@@ -268,3 +271,36 @@ def test_the_solver_iterations_reach_pybullet() -> None:
     with pytest.raises(ParameterError) as error:
         robot_with_overrides("g1", (("solver_iterations", "0"),), "pybullet")
     assert error.value.field == "solver_iterations"
+
+
+def test_the_dcm_inset_of_a_robot_reaches_its_planner() -> None:
+    """G1's description sets row (27c'); --set dcm_inset=none removes it."""
+    _, config, _ = build_backend("lipm", "g1", "rsg")
+    assert config.rsg.dcm_inset == get_robot("g1").dcm_inset == 0.02
+    _, config, _ = build_backend("lipm", "g1", "rsg", overrides=(("dcm_inset", "none"),))
+    assert config.rsg.dcm_inset is None
+    with pytest.raises(ParameterError) as error:
+        build_backend("lipm", "g1", "rsg", overrides=(("dcm_inset", "0.5"),))
+    assert error.value.field == "dcm_inset"
+
+
+def test_locked_joints_are_welded_in_pybullet_and_set_unlocks_them() -> None:
+    """G1's locked arm joints are not PyBullet joints (no motor, no degree of freedom);
+    ``--set locked_joints=none`` actuates all 29, and a name that is not a joint of the
+    URDF is an error naming the field."""
+    from app.pybullet_robot import SimulatedRobot
+
+    g1 = get_robot("g1")
+    for overrides, count in (((), 29 - len(g1.locked_joints)), ((("locked_joints", "none"),), 29)):
+        description, _ = robot_with_overrides("g1", overrides, "pybullet")
+        robot = SimulatedRobot(description)
+        try:
+            assert len(robot.joint_names) == count
+            assert set(robot.joint_names).isdisjoint(description.locked_joints)
+            assert robot.mass == pytest.approx(g1.total_mass, abs=0.1)
+        finally:
+            robot.close()
+    description, _ = robot_with_overrides("g1", (("locked_joints", "no_such_joint"),))
+    with pytest.raises(ParameterError) as error:
+        SimulatedRobot(description)
+    assert error.value.field == "locked_joints"

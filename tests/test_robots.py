@@ -6,12 +6,13 @@ import dataclasses
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from planner.exceptions import ParameterError
 from robots import available_robots, get_robot
 from robots.urdf_cache import derive_urdf_text, derived_urdf, robots_share_dir
-from robots.urdf_merge import merge_fixed_links
+from robots.urdf_merge import lock_joints, merge_fixed_links
 
 
 @pytest.fixture(autouse=True)
@@ -106,6 +107,10 @@ SYNTHETIC_URDF = """<robot name="r">
 </robot>"""
 
 
+C_LINK = """<link name="c"><inertial><origin xyz="0 0.3 0" rpy="0 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>"""
+
+
 def test_merging_a_fixed_link_keeps_mass_com_inertia_and_shapes_in_place():
     root = ET.fromstring(SYNTHETIC_URDF)
     merge_fixed_links(root)
@@ -132,12 +137,16 @@ def test_merging_a_fixed_link_keeps_mass_com_inertia_and_shapes_in_place():
     )
 
 
-def test_merged_g1_has_the_same_joints_mass_and_com_in_pybullet():
+def test_merged_g1_has_the_same_mass_and_com_in_pybullet_with_its_locked_joints_welded():
+    """The physics URDF (locked joints welded at their standing angle, fixed links
+    merged) has the free joints of the full URDF and, with the locked joints of the
+    full one at their standing angles, the same mass and whole-body CoM."""
     import numpy as np
     import pybullet
     from pybullet_utils.bullet_client import BulletClient
 
     g1 = get_robot("g1")
+    assert len(g1.locked_joints) == 10
     merged = ET.parse(derived_urdf(g1, merged=True)).getroot()
     assert not [joint for joint in merged.iter("joint") if joint.get("type") == "fixed"]
     coms = []
@@ -149,8 +158,11 @@ def test_merged_g1_has_the_same_joints_mass_and_com_in_pybullet():
             info = client.getJointInfo(body, index)
             if info[2] == pybullet.JOINT_REVOLUTE:
                 joints[info[1].decode()] = index
-        for number, (_, index) in enumerate(sorted(joints.items())):
-            client.resetJointState(body, index, 0.3 * np.sin(number))
+        free = sorted(set(joints) - set(g1.locked_joints))
+        for number, name in enumerate(free):
+            client.resetJointState(body, joints[name], 0.3 * np.sin(number))
+        for name in set(joints) & set(g1.locked_joints):
+            client.resetJointState(body, joints[name], g1.standing_posture.get(name, 0.0))
         links = range(client.getNumJoints(body))
         masses = [client.getDynamicsInfo(body, link)[0] for link in (-1, *links)]
         positions = [client.getBasePositionAndOrientation(body)[0]]
@@ -158,9 +170,60 @@ def test_merged_g1_has_the_same_joints_mass_and_com_in_pybullet():
         coms.append((sorted(joints), sum(masses), np.array(masses) @ np.array(positions)))
         client.disconnect()
     (names, mass, moment), (merged_names, merged_mass, merged_moment) = coms
-    assert merged_names == names and len(names) == 29
+    assert len(names) == 29
+    assert merged_names == sorted(set(names) - set(g1.locked_joints))
     assert merged_mass == pytest.approx(mass, abs=1e-9)
     assert merged_moment / merged_mass == pytest.approx(moment / mass, abs=1e-6)
+
+
+def test_locking_a_joint_welds_its_child_where_that_angle_puts_it():
+    """bc (about x) locked at 0.5 rad, then merged: c's CoM lands where the joint at
+    0.5 rad puts it."""
+    import math
+
+    root = ET.fromstring(SYNTHETIC_URDF.replace('<link name="c"/>', C_LINK))
+    lock_joints(root, {"bc": 0.5})
+    merge_fixed_links(root)
+    assert [link.get("name") for link in root.iter("link")] == ["a"]
+    inertial = root.find("link/inertial")
+    assert float(inertial.find("mass").get("value")) == pytest.approx(4.0)
+    com = np.array([float(v) for v in inertial.find("origin").get("xyz").split()])
+    # a: 2 kg at (0, 0, 0.1); b: 1 kg at (0, 0.7, 0); c: 1 kg, its CoM in b's frame at
+    # (0, 0.3 cos 0.5, 1 + 0.3 sin 0.5), and b is a's frame moved by (0, 0.5, 0) and
+    # turned by 90 deg about z (b's y axis is a's -x).
+    c_com = np.array([-0.3 * math.cos(0.5), 0.5, 1.0 + 0.3 * math.sin(0.5)])
+    expected = (2 * np.array([0.0, 0.0, 0.1]) + np.array([0.0, 0.7, 0.0]) + c_com) / 4
+    assert com == pytest.approx(expected)
+
+
+def test_locking_names_only_revolute_joints():
+    root = ET.fromstring(SYNTHETIC_URDF)
+    with pytest.raises(ParameterError) as error:
+        lock_joints(root, {"ab": 0.0})  # fixed already
+    assert error.value.field == "locked_joints" and error.value.value == "ab"
+    with pytest.raises(ParameterError):
+        lock_joints(root, {"no_such_joint": 0.0})
+
+
+def test_locked_joints_are_validated_against_the_upper_body_and_the_urdf():
+    from kinematics.whole_body_ik import WholeBodyIK
+
+    g1 = get_robot("g1")
+    with pytest.raises(ParameterError) as error:
+        dataclasses.replace(g1, locked_joints=(g1.upper_body_joints[0],))
+    assert error.value.field == "locked_joints"
+    with pytest.raises(ParameterError):
+        dataclasses.replace(g1, locked_joints=("a_joint", "a_joint"))
+    with pytest.raises(ParameterError) as error:
+        WholeBodyIK(dataclasses.replace(g1, locked_joints=("no_such_joint",)))
+    assert error.value.value == ["no_such_joint"]
+
+
+@pytest.mark.parametrize("value", [0.2, -0.2, float("nan")])
+def test_dcm_inset_of_a_description_is_validated(value):
+    with pytest.raises(ParameterError) as error:
+        dataclasses.replace(get_robot("g1"), dcm_inset=value)
+    assert error.value.field == "dcm_inset"
 
 
 def test_talos_description_validates_and_names_joints_of_its_urdf():
