@@ -111,6 +111,10 @@ def run_command(args: argparse.Namespace) -> int:
         result.impulse_scale = factor
         if robot is not None:
             result.extra["robot"] = robot
+        description = getattr(backend, "description", None)
+        if args.model == "pybullet" and description is not None:
+            # The physics model: these joints are welded at their standing angles.
+            result.extra["locked_joints"] = list(description.locked_joints)
         if overrides:
             result.extra["overrides"] = dict(overrides)
     finally:

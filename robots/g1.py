@@ -147,9 +147,9 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
 * ``dcm_inset`` 0.02 m (planner row (27c')): a QP step puts the new sole's centre
   line at least 2 cm outside the predicted DCM. With the arms locked, ``paper-fig6``
   fell at 6.6 s without it and is recovered with it (15 steps, 2 adjusted), and so
-  are 7 of its 9 variants (pushes shifted by up to 60 ms or scaled by 0.9 and 1.1)
-  against 4 without; the late pushes 26 against 21 (README, "Pushes late in single
-  support").
+  are 7 of its 9 variants (recovered: both pushes shifted by 20, 40 or 60 ms either
+  way; fell: scaled by 0.9 and by 1.1) against 4 without; the late pushes 26 against
+  21 (README, "Pushes late in single support").
 * ``landing_clearance`` 2 mm: a swing sole commanded down to the ground touched it
   30-40 ms before the planner's step, took the whole weight at once (up to 940 N,
   toe first) and kicked the DCM by 1.5-2 cm sideways, i.e. above the RSG's

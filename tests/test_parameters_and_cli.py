@@ -187,3 +187,19 @@ def test_the_physics_log_needs_the_full_robot(tmp_path, capsys) -> None:
     error = capsys.readouterr().err
     assert "--model" in error and "pybullet" in error and "Traceback" not in error
     assert not (tmp_path / "physics.csv").exists()
+
+
+def test_a_robot_run_records_its_physics_model_and_real_time_factor(tmp_path) -> None:
+    """``rsg run`` on G1 (the default model and robot) writes the summary with the
+    real-time factor and the joints welded in its physics model."""
+    from robots import get_robot
+
+    code = main(["run", "--scenario", "walk", "--duration", "0.3", "--no-plots", "--quiet",
+                 "--out", str(tmp_path)])  # fmt: skip
+    assert code in (0, 1)  # 0.3 s: too short for two nominal steps, so maybe not "recovered"
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary["model"] == "pybullet" and summary["robot"] == "g1"
+    assert summary["fell"] is False and summary["sim_time"] == pytest.approx(0.3)
+    assert summary["real_time_factor"] > 0.0
+    assert summary["locked_joints"] == list(get_robot("g1").locked_joints)
+    assert summary["parameters"]["dcm_inset"] == 0.02
