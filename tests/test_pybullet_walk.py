@@ -3,10 +3,11 @@
 The walk, push and paper-fig6 tests state the goals of the full-robot backend.
 Status, measured with the G1 defaults of ``robots/g1.py``: the 20 s walk is recovered
 (24 steps, none adjusted, max V_u 0.35 gamma_v); 10 N s at mid single support is
-recovered in all 8 directions; paper-fig6 is recovered (16 steps, 4 adjusted, max V_u
-6.3 gamma_v) since a timing jump no longer postpones a step due sooner than the
-reaction time (it fell at 6.0 s before: the step came 0.08 s late, the lateral DCM
-error at the touchdown was more than the 5 cm sole holds). Pushes late in single
+recovered in all 8 directions; paper-fig6 is recovered (15 steps, 2 adjusted, max V_u
+11 gamma_v, with the arms welded and ``dcm_inset`` 0.02 m; with all 29 joints and no
+inset: 16 steps, 4 adjusted) since a timing jump no longer postpones a step due sooner
+than the reaction time (it fell at 6.0 s before: the step came 0.08 s late, the lateral
+DCM error at the touchdown was more than the 5 cm sole holds). Pushes late in single
 support remain G1's weak spot (README, "The full robot"); see also
 ``rsg run --physics-log``.
 """
