@@ -148,6 +148,7 @@ from planner.parameters import LipmModel
 from planner.types import Foot, MeasuredState, PlannerOutput, Vector2, other_foot
 from robots import get_robot
 from robots.description import RobotDescription
+from robots.urdf_cache import locked_angles
 
 INITIAL_VELOCITY_HORIZON = 0.01  # [s] finite difference used to start with a CoM velocity
 SWING_FEEDBACK_LIMIT = 0.05  # bound on the swing sole's measured offset [m]
@@ -321,6 +322,8 @@ class PyBulletBackend:
                 and the swing foot comes down early).
         """
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
+        # Welded in the physics: not measured, shown at the angle they are welded at.
+        self._locked_angles = locked_angles(self.description)
         substeps = round(control_period / PHYSICS_TIME_STEP)
         if substeps < 1 or abs(substeps * PHYSICS_TIME_STEP - control_period) > 1e-9:
             raise ParameterError("control_period", control_period, "a positive multiple of 1 ms")
@@ -903,11 +906,7 @@ class PyBulletBackend:
         """URDF base position [m], quaternion (x, y, z, w) and joint angles [rad]
         (the description's locked joints at their standing angle)."""
         position, quaternion = self.sim.base_pose()
-        locked = {
-            name: self.description.standing_posture.get(name, 0.0)
-            for name in self.description.locked_joints
-        }
-        return position, quaternion, {**locked, **self.sim.joint_angles()}
+        return position, quaternion, {**self._locked_angles, **self.sim.joint_angles()}
 
     def sole_positions(self) -> dict[str, NDArray[np.float64]]:
         """Measured sole origin of each foot in the world [m], shape (3,)."""
