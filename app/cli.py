@@ -127,7 +127,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--physics-log",
         action="store_true",
-        help="also write physics.csv: CoM, foot forces and CoPs, soles at every 1 ms "
+        help="also write physics.csv: CoM, foot forces and CoPs, soles at every "
         "physics step (--model pybullet; touchdowns and impacts)",
     )
     run.add_argument("--quiet", action="store_true", help="no progress bar")

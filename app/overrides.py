@@ -46,8 +46,9 @@ from robots.description import RobotDescription
 Overrides = tuple[tuple[str, str], ...]
 
 #: Description fields that may be set: the numbers of the gait, the planner's bounds
-#: and timing, the fall thresholds, PyBullet's solver iterations and the locked
-#: joints (comma-separated names, or ``none``; not the URDF, links, sole or gains).
+#: and timing, the fall thresholds, PyBullet's time step (the position gains follow,
+#: keeping the servos' time constants) and solver iterations, and the locked joints
+#: (comma-separated names, or ``none``; not the URDF, links, sole or gains).
 DESCRIPTION_FIELDS = {
     "com_height": "float",
     "foot_spacing": "float",
@@ -69,6 +70,7 @@ DESCRIPTION_FIELDS = {
     "step_reaction_time": "float",
     "reanchor_time": "float",
     "dcm_inset": "float | None",
+    "physics_time_step": "float",
     "solver_iterations": "int",
     "locked_joints": "names",
 }
@@ -260,8 +262,11 @@ def apply_to_description(
     """``description`` with the description fields and backend options of ``parsed``."""
     if not parsed.description and not parsed.backend:
         return description
+    fields = dict(parsed.description)
+    if "physics_time_step" in fields:  # with the gains that keep the servos' time constants
+        description = description.with_physics_time_step(fields.pop("physics_time_step"))
     options = {**description.backend_options, **parsed.backend}
-    return dataclasses.replace(description, **parsed.description, backend_options=options)
+    return dataclasses.replace(description, **fields, backend_options=options)
 
 
 def apply_to_rsg(rsg: RsgParameters, parsed: ParsedOverrides) -> RsgParameters:

@@ -1,7 +1,7 @@
-"""Per-physics-step log of a full-robot run: contacts, CoM and soles at 1 kHz.
+"""Per-physics-step log of a full-robot run: contacts, CoM and soles at every step.
 
 The control tick (10 ms) hides what happens at a touchdown: a sole that lands early
-takes the weight within one or two 1 ms steps, an impact of several kN can throw the
+takes the weight within a few milliseconds, an impact of several kN can throw the
 whole robot off the ground for tens of milliseconds, and the feet can rock in turn.
 ``rsg run --physics-log`` records, after every physics step, the whole-body CoM
 position and velocity, each foot's normal force and CoP, and each sole's position,
@@ -11,7 +11,8 @@ The log only observes: the run with it ends in exactly the state of the run with
 it (a test checks this). PyBullet refreshes its collision transforms when asked for
 forward kinematics, which changes the next contact solution slightly, so the sole
 positions are read as PyBullet left them after the step's collision detection:
-one 1 ms step behind the CoM columns (at most 1.5 mm for a sole moving at 1.5 m/s).
+one physics step behind the CoM columns (3 mm for a sole moving at 1.5 m/s at G1's
+2 ms step).
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """Full-humanoid backend: the planner's commands realised on a robot in PyBullet.
 
-Each control tick (``control_period``, several 1 ms physics steps):
+Each control tick (``control_period``, several physics steps of the robot's
+``physics_time_step``: 2 ms on G1, 1 ms on Talos):
 
 1. CoM plan: a CoM reference state (c_ref, v_ref) is integrated over the tick
    with the LIPM driven by the commanded ZMP and rate of angular momentum; before
@@ -138,7 +139,7 @@ from app.physics_log import PhysicsLog
 from app.pybullet_ankle import MIN_LOAD_FRACTION, AnkleCopFeedback
 from app.pybullet_com_plan import cop_admittance_zmp, momentum_aware_pivot
 from app.pybullet_landing import LandingCorrection
-from app.pybullet_robot import GRAVITY, PHYSICS_TIME_STEP, SimulatedRobot
+from app.pybullet_robot import GRAVITY, SimulatedRobot
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
@@ -215,7 +216,7 @@ class PyBulletBackend:
 
         Args:
             robot: Registry name or description of the robot.
-            control_period: Control period [s], a multiple of 1 ms.
+            control_period: Control period [s], a multiple of the robot's physics step.
             timing: Step timing of the planner (T_DSP, T_SP, nominal step time).
             com_lookahead: Extra horizon [s] by which the IK CoM target leads the
                 CoM reference (compensates the position-control lag).
@@ -324,9 +325,14 @@ class PyBulletBackend:
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         # Welded in the physics: not measured, shown at the angle they are welded at.
         self._locked_angles = locked_angles(self.description)
-        substeps = round(control_period / PHYSICS_TIME_STEP)
-        if substeps < 1 or abs(substeps * PHYSICS_TIME_STEP - control_period) > 1e-9:
-            raise ParameterError("control_period", control_period, "a positive multiple of 1 ms")
+        physics_step = self.description.physics_time_step
+        substeps = round(control_period / physics_step)
+        if substeps < 1 or abs(substeps * physics_step - control_period) > 1e-9:
+            raise ParameterError(
+                "control_period",
+                control_period,
+                f"a positive multiple of the physics step {1e3 * physics_step:g} ms",
+            )
         self.control_period = control_period
         self._substeps = substeps
         if not com_lookahead >= 0.0:

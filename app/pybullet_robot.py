@@ -23,7 +23,6 @@ from robots.description import RobotDescription
 from robots.urdf_cache import derived_urdf
 
 GRAVITY = 9.81  # [m/s^2]
-PHYSICS_TIME_STEP = 1e-3  # [s]
 
 
 class SimulatedRobot:
@@ -34,15 +33,18 @@ class SimulatedRobot:
         link_masses: Mass of each body part [kg]; index 0 is the base.
         mass: Total mass [kg].
         foot_links: Foot -> PyBullet link index of its ankle link.
+        time_step: PyBullet's fixed time step [s] (the description's).
+        time: Simulated time [s].
     """
 
     def __init__(self, description: RobotDescription) -> None:
         self.description = description
+        self.time_step = description.physics_time_step
         self.client = BulletClient(connection_mode=pybullet.DIRECT)
         client = self.client
         client.setGravity(0.0, 0.0, -GRAVITY)
         client.setPhysicsEngineParameter(
-            fixedTimeStep=PHYSICS_TIME_STEP,
+            fixedTimeStep=description.physics_time_step,
             numSolverIterations=description.solver_iterations,
             deterministicOverlappingPairs=1,
         )
@@ -254,7 +256,7 @@ class SimulatedRobot:
         )
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
-        """One physics step of PHYSICS_TIME_STEP [s] with a force [N] on the base CoM.
+        """One physics step (``time_step`` [s]) with a force [N] on the base CoM.
 
         PyBullet clears external forces after each step, so a push lasting several
         steps must be applied at every step. ``None`` (or a zero force) applies none.
@@ -266,7 +268,7 @@ class SimulatedRobot:
             )
         self._step_simulation(physicsClientId=self._client_id)
         self._contacts = None
-        self.time += PHYSICS_TIME_STEP
+        self.time += self.time_step
 
     def close(self) -> None:
         """Disconnect the PyBullet client (idempotent)."""

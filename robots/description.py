@@ -8,6 +8,7 @@ frame of a foot has its origin on the ground below the ankle, x forward, z up.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -22,8 +23,10 @@ class JointGains:
     """PyBullet POSITION_CONTROL parameters of one joint.
 
     Attributes:
-        position_gain: PyBullet ``positionGain`` kp [1/s-ish, PyBullet's velocity
-            constraint scaling], in (0, 1].
+        position_gain: PyBullet ``positionGain`` kp [-], in (0, 1]: the joint motor's
+            velocity target is kp (target - angle) / dt at each physics step of dt,
+            so the servo's time constant is about dt / kp
+            (``RobotDescription.physics_time_step``).
         velocity_gain: PyBullet ``velocityGain`` kd [-], in [0, 1.5].
         max_force: Maximum joint torque the motor may apply [N m], > 0.
     """
@@ -39,6 +42,12 @@ class JointGains:
             raise ParameterError("velocity_gain", self.velocity_gain, "0 <= kd <= 1.5")
         if not self.max_force > 0.0:
             raise ParameterError("max_force", self.max_force, "> 0 N m")
+
+
+def _check_physics_time_step(value: float) -> None:
+    """Raise a ParameterError naming ``physics_time_step`` unless 0.5 ms <= value <= 5 ms."""
+    if not (isinstance(value, float) and 0.0005 <= value <= 0.005):
+        raise ParameterError("physics_time_step", value, "a number in [0.0005, 0.005] s")
 
 
 @dataclass(frozen=True)
@@ -114,6 +123,10 @@ class RobotDescription:
         dcm_inset: The planner's row (27c') [m] (``RsgParameters.dcm_inset``): a QP
             step puts the new sole's centre line at least this far outside the
             predicted DCM; None: (27c) as printed.
+        physics_time_step: PyBullet's fixed time step [s], in [0.0005, 0.005];
+            the control period must be a multiple of it. The joint gains are per
+            step (:class:`JointGains`); :meth:`with_physics_time_step` changes the
+            step and keeps the servos' time constants.
         solver_iterations: Iterations of PyBullet's contact and joint-motor
             solver per physics step (its cost grows with them; 1 to 200).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
@@ -161,6 +174,7 @@ class RobotDescription:
     step_reaction_time: float = 0.0
     reanchor_time: float = 0.0
     dcm_inset: float | None = None
+    physics_time_step: float = 0.001
     solver_iterations: int = 50
     sole_box_collision: bool = False
     upper_body_joints: tuple[str, ...] = ()
@@ -195,6 +209,7 @@ class RobotDescription:
             raise ParameterError(
                 "sole_spinning_friction", self.sole_spinning_friction, "in [0, 0.1] m"
             )
+        _check_physics_time_step(self.physics_time_step)
         iterations = self.solver_iterations
         if type(iterations) is not int or not 1 <= iterations <= 200:  # not a bool either
             raise ParameterError(
@@ -219,6 +234,36 @@ class RobotDescription:
         # Freeze the mappings so the description stays immutable and hashable-safe.
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
         object.__setattr__(self, "joint_gains", MappingProxyType(dict(self.joint_gains)))
+
+    def with_physics_time_step(self, time_step: float) -> RobotDescription:
+        """This description with PyBullet's step ``time_step`` [s] and every position
+        gain scaled by ``time_step / physics_time_step``, so each joint servo keeps its
+        time constant (about dt / kp, see :class:`JointGains`).
+
+        Raises:
+            ParameterError: ``time_step`` is outside [0.0005, 0.005] s, or a scaled
+                gain would exceed 1 (PyBullet's bound; the message names the joint).
+        """
+        _check_physics_time_step(time_step)
+        scale = time_step / self.physics_time_step
+
+        def scaled(joint: str, gains: JointGains) -> JointGains:
+            gain = gains.position_gain * scale
+            if gain > 1.0:
+                raise ParameterError(
+                    f"physics_time_step (position gain of {joint})",
+                    time_step,
+                    f"a step at most {self.physics_time_step / gains.position_gain:g} s, "
+                    "where the scaled gain reaches PyBullet's bound 1",
+                )
+            return dataclasses.replace(gains, position_gain=gain)
+
+        return dataclasses.replace(
+            self,
+            physics_time_step=time_step,
+            default_gains=scaled("the default", self.default_gains),
+            joint_gains={joint: scaled(joint, g) for joint, g in self.joint_gains.items()},
+        )
 
     def gains_of(self, joint: str) -> JointGains:
         """PyBullet gains of ``joint`` (its own, else the defaults)."""

@@ -144,6 +144,25 @@ Walking choices (measured in PyBullet, see ``app/pybullet_backend.py``):
   pushes at phases 0.5625 and 0.25 54 instead of 53, on the 32 late pushes 26 instead of
   21, 10 N s at mid single support 8 of 8 either way; ``--set locked_joints=none``
   actuates them again.
+* ``physics_time_step`` 2 ms (500 Hz) with ``solver_iterations`` 75 and position
+  gains 0.4 (legs, waist, arms) and 0.2 (ankles), instead of 1 ms with 50 iterations and
+  gains 0.1 and 0.05: physics was three quarters of a control tick, and this halves its
+  steps. PyBullet's position gain is per step (the servo's time constant is about
+  dt / kp, tested on a one-joint arm), so 0.1 at 1 ms and 0.2 at 2 ms hold the same
+  10 ms. At 2 ms with 50 iterations, leg gains (ankles at half) of 0.1 fell in
+  ``paper-fig6``; on the 64 pushes at phases 0.5625 and 0.25 0.15, 0.2, 0.3, 0.4, 0.5
+  and 0.6 were not fallen after 35, 47, 53, 55, 53 and 53 (1 ms defaults: 54). With 0.4
+  and 50 iterations 10 N s at mid single support was recovered in 7 of 8 directions;
+  with 75 iterations in 8 of 8, and at phases 0.5, 0.5625 and 0.625 in 21 of 24 (1 ms
+  defaults: 20; 50 iterations: 19). Not fallen
+  (recovered), against the 1 ms defaults: the 64 pushes 32 + 21 = 53 (53) against 54
+  (54); the 32 late pushes 26 (25) against 26; ``paper-fig6`` recovered (17 steps, 6
+  adjusted); its variants 12 of 17 against 14 (both pushes shifted by 0, +-10, ..., +-60
+  ms or scaled by 0.9, 0.95, 1.05 and 1.1); fixed-timing 25 + 21 against 26 + 19 and
+  no-step 13 + 11 against 14 + 11 on the 64 pushes; 1 kHz with the same servo time
+  constants (``--set physics_time_step=0.001 --set solver_iterations=50``, gains
+  halved) 31 + 23 = 54. The 20 s walk: 24 steps, none adjusted, V_u peak 0.66 gamma_v
+  (0.34 at 1 ms). The real-time factor: README, "``rsg bench``".
 * ``dcm_inset`` 0.02 m (planner row (27c')): a QP step puts the new sole's centre
   line at least 2 cm outside the predicted DCM. With the arms locked, ``paper-fig6``
   fell at 6.6 s without it and is recovered with it (15 steps, 2 adjusted), and so
@@ -183,9 +202,9 @@ STANDING_POSTURE = {
     "right_shoulder_roll_joint": -_SHOULDER_ROLL,
 }
 
-_LEG_GAINS = JointGains(position_gain=0.1, velocity_gain=1.0, max_force=139.0)
-_ANKLE_GAINS = JointGains(position_gain=0.05, velocity_gain=1.0, max_force=50.0)
-_ARM_GAINS = JointGains(position_gain=0.1, velocity_gain=1.0, max_force=25.0)
+_LEG_GAINS = JointGains(position_gain=0.4, velocity_gain=1.0, max_force=139.0)
+_ANKLE_GAINS = JointGains(position_gain=0.2, velocity_gain=1.0, max_force=50.0)
+_ARM_GAINS = JointGains(position_gain=0.4, velocity_gain=1.0, max_force=25.0)
 
 JOINT_GAINS = {
     **{
@@ -241,8 +260,10 @@ G1 = RobotDescription(
     foot_spacing=0.23,
     standing_posture=STANDING_POSTURE,
     joint_gains=JOINT_GAINS,
-    default_gains=JointGains(position_gain=0.1, velocity_gain=1.0, max_force=88.0),
+    default_gains=JointGains(position_gain=0.4, velocity_gain=1.0, max_force=88.0),
     total_mass=33.3,
+    physics_time_step=0.002,
+    solver_iterations=75,
     fall_base_height=0.45,
     swing_height=0.06,
     sole_box_collision=True,

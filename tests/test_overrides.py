@@ -267,10 +267,48 @@ def test_the_solver_iterations_reach_pybullet() -> None:
         assert parameters["numSolverIterations"] == 30
     finally:
         robot.close()
-    assert get_robot("g1").solver_iterations == 50
+    assert get_robot("g1").solver_iterations == 75
     with pytest.raises(ParameterError) as error:
         robot_with_overrides("g1", (("solver_iterations", "0"),), "pybullet")
     assert error.value.field == "solver_iterations"
+
+
+def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
+    """``--set physics_time_step=0.001`` runs G1's physics at 1 kHz instead of 500 Hz:
+    PyBullet's fixed step, the simulated time per step, the steps per control tick and
+    the position gains (halved: the same servo time constants) follow. A step that
+    does not divide the control period is an error naming it before any run."""
+    from app.pybullet_robot import SimulatedRobot
+
+    g1 = get_robot("g1")
+    for text, step in (("0.001", 0.001), (None, g1.physics_time_step)):
+        overrides = () if text is None else (("physics_time_step", text),)
+        description, _ = robot_with_overrides("g1", overrides, "pybullet")
+        assert description.physics_time_step == step
+        knee = description.gains_of("left_knee_joint").position_gain
+        assert knee == pytest.approx(g1.gains_of("left_knee_joint").position_gain * step / 0.002)
+        robot = SimulatedRobot(description)
+        try:
+            assert robot.client.getPhysicsEngineParameters()["fixedTimeStep"] == step
+            robot.step()
+            robot.step()
+            assert robot.time == pytest.approx(2 * step)
+        finally:
+            robot.close()
+        backend, config, initial = build_robot_backend("g1", "rsg", overrides=overrides)
+        try:
+            assert backend._substeps == round(backend.control_period / step)
+            result = run_closed_loop(backend, config, Scenario("walk", 0.1), initial)
+            assert not result.fall.fell
+            assert backend.sim.time == pytest.approx(0.1)  # ticks x substeps x step
+        finally:
+            backend.close()
+    with pytest.raises(ParameterError) as error:
+        build_robot_backend("g1", "rsg", overrides=(("physics_time_step", "0.003"),))
+    assert error.value.field == "control_period"
+    with pytest.raises(ParameterError) as error:
+        robot_with_overrides("g1", (("physics_time_step", "0.01"),), "pybullet")
+    assert error.value.field == "physics_time_step"
 
 
 def test_the_dcm_inset_of_a_robot_reaches_its_planner() -> None:
