@@ -329,9 +329,9 @@ class PyBulletBackend:
         substeps = round(control_period / physics_step)
         if substeps < 1 or abs(substeps * physics_step - control_period) > 1e-9:
             raise ParameterError(
-                "control_period",
-                control_period,
-                f"a positive multiple of the physics step {1e3 * physics_step:g} ms",
+                "control_period/physics_time_step",
+                (control_period, physics_step),
+                "a control period that is a whole multiple of the physics step [s]",
             )
         self.control_period = control_period
         self._substeps = substeps

@@ -305,7 +305,8 @@ def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
             backend.close()
     with pytest.raises(ParameterError) as error:
         build_robot_backend("g1", "rsg", overrides=(("physics_time_step", "0.003"),))
-    assert error.value.field == "control_period"
+    assert error.value.field == "control_period/physics_time_step"
+    assert error.value.value == (0.01, 0.003)
     with pytest.raises(ParameterError) as error:
         robot_with_overrides("g1", (("physics_time_step", "0.01"),), "pybullet")
     assert error.value.field == "physics_time_step"
