@@ -223,9 +223,8 @@ class RobotDescription:
         ):
             raise ParameterError("dcm_inset", self.dcm_inset, "None or in [-0.1, 0.1] m")
         locked = tuple(self.locked_joints)
-        if any(not isinstance(name, str) or not name for name in locked) or len(set(locked)) != len(
-            locked
-        ):
+        named = all(isinstance(name, str) and name for name in locked)
+        if not named or len(set(locked)) != len(locked):
             raise ParameterError("locked_joints", self.locked_joints, "distinct joint names")
         moved = sorted(set(locked) & set(self.upper_body_joints))
         if moved:
