@@ -129,15 +129,12 @@ def run_command(args: argparse.Namespace) -> int:
                 f"impulses scaled by {factor:.3f} (robot mass {backend.mass:.1f} kg / "
                 f"{scenario.reference_mass:.1f} kg) so the velocity change matches"
             )
+        bar = ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet)
         result = run_closed_loop(
-            backend,
-            config,
-            scaled,
-            initial,
-            progress=ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet),
-            planner=planner,
-            interruptible=True,
+            backend, config, scaled, initial, progress=bar, planner=planner, interruptible=True
         )
+        if result.interrupted and bar.enabled:
+            sys.stderr.write("\n")  # end the bar's line
         result.impulse_scale = factor
         result.extra["pushes_left_out"] = [
             Push(p.time, np.asarray(p.impulse, dtype=float) * factor, p.duration) for p in left_out
