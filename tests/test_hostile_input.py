@@ -454,7 +454,7 @@ OVERRIDES = [
         "control_period=0.5",
         "--set control_period",
         "'0.5'",
-        "[0.001, 0.02] s",
+        "[0.002, 0.012] s",
         model="pybullet",
     ),
     set_case(
@@ -557,7 +557,7 @@ OVERRIDES = [
         "sweep-backend-option",
         "control_period=0.5",
         "--set control_period",
-        "[0.001, 0.02] s",
+        "[0.002, 0.012] s",
         model="pybullet",
         command="sweep",
     ),
