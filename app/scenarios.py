@@ -288,10 +288,12 @@ def _shown(value: Any) -> Any:
     return value if len(text) <= 80 else text[:77] + "..."
 
 
-def _text(source: str, value: Any, longest: int) -> str:
-    if not isinstance(value, str) or len(value) > longest or not value.isprintable():
+def _text(source: str, value: Any, longest: int, shortest: int = 0) -> str:
+    if not (isinstance(value, str) and shortest <= len(value) <= longest and value.isprintable()):
         raise ParameterError(
-            source, _shown(value), f"a string of printable characters, at most {longest}"
+            source,
+            _shown(value),
+            f"a string of {shortest} to {longest} printable characters",
         )
     return value
 
@@ -305,7 +307,7 @@ def scenario_from_toml(data: dict[str, Any], source: str, default_name: str) -> 
     unknown = sorted(set(data) - set(TOP_KEYS))
     if unknown:
         raise ParameterError(f"{source} keys", _shown(unknown), f"only {', '.join(TOP_KEYS)}")
-    name = _text(f"{source} name", data.get("name", default_name), 100)
+    name = _text(f"{source} name", data.get("name", default_name), 100, shortest=1)
     description = _text(f"{source} description", data.get("description", ""), 1000)
     duration = _number(f"{source} duration", data.get("duration", 12.0), DURATION)
     reference_mass = data.get("reference_mass")
