@@ -17,16 +17,20 @@ A name is looked up in this order:
 
 On ``--model lipm`` (the paper's point mass) every RSG parameter may be set, and
 nothing else. On ``--model lipm --robot NAME`` (the robot's planner on the point
-mass) the description fields and the RSG parameters of 1. and 3. may be set.
+mass) the description fields its planner reads and the RSG parameters of 3.
 
 RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
 (``cop_feedback=0,2``), ``none`` where the option allows it, or a word for a
 string option (``plan_angular_momentum=feedback``), or comma-separated joint names
-(``locked_joints=none`` actuates every joint). Ranges are checked where the
-parameter is used (the description, the backend, the planner), each with an error
-that names it.
+(``locked_joints=none`` actuates every joint). Numbers are ASCII decimals (no nan,
+inf, hex or ``_``). Each parameter has a range, defined where the parameter is (the
+planner's ``planner.parameters.RANGES``, the description, the backend's
+``OPTION_RANGES``); :func:`check_overrides` builds what a run builds, without loading
+a robot, before any work starts, and words every error as the ``--set`` the user gave,
+its value and what is allowed (:func:`blame`). On ``--model lipm`` the settings only the
+full robot reads are refused (:data:`PYBULLET_ONLY_FIELDS`, the backend options).
 """
 
 from __future__ import annotations
