@@ -29,7 +29,6 @@ import argparse
 import json
 import time
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -40,7 +39,8 @@ from planner.parameters import PlannerConfig
 from planner.step_qp import build_step_qp, solve_step_qp
 
 from .lipm_backend import LipmBackend
-from .overrides import Overrides, add_set_argument
+from .overrides import Overrides, add_set_argument, check_overrides, decimal_argument
+from .result_folder import add_out_arguments, prepare_out
 from .robot_setup import check_robot_overrides
 from .runner import ClosedLoop
 from .scenarios import BUILT_IN, Scenario
@@ -258,11 +258,12 @@ def add_bench_parser(sub: argparse._SubParsersAction) -> None:
         "prints a table and writes bench.json.",
     )
     p.add_argument("--robot", default="g1", help="robot for the full-robot part (default g1)")
-    p.add_argument("--duration", type=float, default=4.0, help="full-robot walk [s] (4)")
+    p.add_argument("--duration", type=decimal_argument("--duration"), default=4.0,
+                   help="full-robot walk [s] (4)")  # fmt: skip
     p.add_argument("--samples", type=int, default=1000, help="sampled step QPs (1000)")
     p.add_argument("--no-robot", action="store_true", help="skip the PyBullet part")
     add_set_argument(p)
-    p.add_argument("--out", type=Path, required=True, help="folder for bench.json")
+    add_out_arguments(p, "bench.json")
 
 
 def bench_command(args: argparse.Namespace) -> int:
@@ -272,7 +273,16 @@ def bench_command(args: argparse.Namespace) -> int:
     if not 10 <= args.samples <= 1_000_000:
         raise ParameterError("--samples", args.samples, "an integer in [10, 1000000]")
     overrides = tuple(args.overrides)
-    check_robot_overrides(args.robot, overrides)
+    if args.no_robot and overrides:
+        raise ParameterError(
+            "--set", " ".join(f"{n}={v}" for n, v in overrides),
+            "no --set with --no-robot (the overrides change only the robot's part)",
+        )  # fmt: skip
+    check_overrides(overrides, "pybullet", args.robot)
+    if not args.no_robot:
+        check_robot_overrides(args.robot, overrides)
+    for deleted in prepare_out(args.out, "bench", args.overwrite):
+        print(f"deleted {deleted} (--overwrite)")
     report: dict = {
         "units": "seconds per call; real_time_factor = simulated / wall time",
         "overrides": [f"{name}={value}" for name, value in overrides],
@@ -285,7 +295,6 @@ def bench_command(args: argparse.Namespace) -> int:
     table = format_bench(report)
     report["table"] = table
     try:
-        args.out.mkdir(parents=True, exist_ok=True)
         path = args.out / "bench.json"
         path.write_text(json.dumps(report, indent=2) + "\n")
     except OSError as exc:

@@ -11,14 +11,14 @@ from __future__ import annotations
 import argparse
 import importlib.metadata
 import sys
-from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 
-from .overrides import add_robot_argument, add_set_argument
-from .scenarios import BUILT_IN, parse_push
+from .overrides import add_robot_argument, add_set_argument, parse_decimal
+from .result_folder import add_out_arguments
+from .scenarios import BUILT_IN, MAX_DURATION, parse_push
 
 MODELS = ("lipm", "pybullet")
 DEFAULT_MODEL = "pybullet"
@@ -31,10 +31,13 @@ examples:
   rsg run --model lipm --scenario my_pushes.toml --out results/mine
   rsg run --model pybullet --controller placo-wpg --scenario walk --duration 4 --out results/wpg
 
-outputs in --out:
-  summary.json     verdict (recovered, fell), steps, pushes, Lyapunov levels, counts
+outputs in --out (a folder with an earlier run's results is refused without --overwrite):
+  summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
+
+exit code: 0 recovered, 1 not recovered, 2 bad input, 130 interrupted (Ctrl-C: what was
+simulated is written, summary.json says "interrupted": true)
 """
 
 
@@ -46,13 +49,20 @@ def _push(text: str):
 
 
 def _positive_seconds(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--duration={text!r}: expected seconds > 0") from None
-    if not 0.0 < value <= 3600.0:
-        raise argparse.ArgumentTypeError(f"--duration={value}: expected seconds in (0, 3600]")
+    value = parse_decimal(text.strip())
+    if value is None or not 0.0 < value <= MAX_DURATION:
+        raise argparse.ArgumentTypeError(
+            f"--duration={text[:60]!r}: expected seconds in (0, {MAX_DURATION:g}]"
+        )
     return value
+
+
+class CommandParser(argparse.ArgumentParser):
+    """An argparse parser whose errors are one line (no usage block), with a pointer to
+    ``--help``."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 PLUGIN_GROUP = "rsg.commands"
@@ -67,7 +77,7 @@ def plugin_commands() -> dict[str, Any]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="rsg",
         description="Reactive step generation for biped push recovery (Lyapunov-based hybrid "
         "tracking control of the DCM), on the LIPM and on a full humanoid in PyBullet.",
@@ -115,7 +125,7 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="simulated time [s] (default: the scenario's)",
     )
-    run.add_argument("--out", type=Path, required=True, help="folder for the results")
+    add_out_arguments(run)
     run.add_argument(
         "--paper-rules",
         action="store_true",

@@ -5,12 +5,12 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from pathlib import Path
 
-from .overrides import add_robot_argument, add_set_argument
+from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
+from .result_folder import add_out_arguments, prepare_out
 from .robot_setup import check_robot_overrides
-from .sweep import SWEEP_CONTROLLERS
+from .sweep import SWEEP_CONTROLLERS, check_workers
 
 EPILOG = """\
 examples:
@@ -28,13 +28,12 @@ outputs in --out:
 
 def _numbers(name: str):  # noqa: ANN202
     def parse(text: str) -> tuple[float, ...]:
-        try:
-            values = tuple(float(part) for part in text.split(",") if part.strip())
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name}={text!r}: numbers like 4,6,8") from None
-        if not values:
-            raise argparse.ArgumentTypeError(f"{name}={text!r}: at least one number")
-        return values
+        values = tuple(parse_decimal(part.strip()) for part in text.split(",") if part.strip())
+        if not values or any(v is None for v in values):
+            raise argparse.ArgumentTypeError(
+                f"{name}={text[:60]!r}: finite decimal numbers like 4,6,8"
+            )
+        return values  # type: ignore[return-value]
 
     return parse
 
@@ -64,17 +63,20 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--phases", type=_numbers("--phases"), default=(0.5625,),
                    help="push phases, fractions of the walking cycle (default 0.5625: mid "
                    "single support)")  # fmt: skip
-    p.add_argument("--duration", type=float, default=0.1, help="push duration [s] (0.1)")
+    p.add_argument("--duration", type=decimal_argument("--duration"), default=0.1,
+                   help="push duration [s] (0.1)")  # fmt: skip
     p.add_argument(
         "--settle",
-        type=float,
+        type=decimal_argument("--settle"),
         default=GridSpec.settle,
         help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
     )
     p.add_argument("--paper-rules", action="store_true",
                    help="the RSG without the documented extensions")  # fmt: skip
-    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
-    p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    p.add_argument("--workers", type=int, default=None,
+                   help="parallel workers (default: the CPU count; at most 4 per CPU, and "
+                   "never more than there are runs)")  # fmt: skip
+    add_out_arguments(p)
     add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip grid.png")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -95,9 +97,12 @@ def grid_command(args: argparse.Namespace) -> int:
         paper_rules=args.paper_rules,
         overrides=tuple(args.overrides),
     )
+    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    check_workers(workers)
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
-    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    for path in prepare_out(args.out, "grid", args.overwrite):
+        print(f"deleted {path} (--overwrite)")
     started = time.perf_counter()
     records = run_grid(spec, workers, progress=not args.quiet)
     wall_time = time.perf_counter() - started

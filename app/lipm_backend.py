@@ -20,6 +20,8 @@ from planner.types import MeasuredState, PlannerOutput, Vector2
 
 from .backend import FallStatus, InitialCondition
 
+CONTROL_PERIOD = 0.001  # [s] the loop's tick on the point mass (1 kHz)
+
 
 class LipmBackend:
     """Closed-form LIPM (1) with the planner's ZMP and angular momentum.
@@ -36,7 +38,7 @@ class LipmBackend:
     def __init__(
         self,
         model: LipmModel,
-        control_period: float = 0.001,
+        control_period: float = CONTROL_PERIOD,
         fall_distance: float = 0.6,
         fall_dcm_error: float = 0.5,
     ) -> None:

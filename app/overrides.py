@@ -17,16 +17,20 @@ A name is looked up in this order:
 
 On ``--model lipm`` (the paper's point mass) every RSG parameter may be set, and
 nothing else. On ``--model lipm --robot NAME`` (the robot's planner on the point
-mass) the description fields and the RSG parameters of 1. and 3. may be set.
+mass) the description fields its planner reads and the RSG parameters of 3.
 
 RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
 (``cop_feedback=0,2``), ``none`` where the option allows it, or a word for a
 string option (``plan_angular_momentum=feedback``), or comma-separated joint names
-(``locked_joints=none`` actuates every joint). Ranges are checked where the
-parameter is used (the description, the backend, the planner), each with an error
-that names it.
+(``locked_joints=none`` actuates every joint). Numbers are ASCII decimals (no nan,
+inf, hex or ``_``). Each parameter has a range, defined where the parameter is (the
+planner's ``planner.parameters.RANGES``, the description, the backend's
+``OPTION_RANGES``); :func:`check_overrides` builds what a run builds, without loading
+a robot, before any work starts, and words every error as the ``--set`` the user gave,
+its value and what is allowed (:func:`blame`). On ``--model lipm`` the settings only the
+full robot reads are refused (:data:`PYBULLET_ONLY_FIELDS`, the backend options).
 """
 
 from __future__ import annotations
@@ -34,8 +38,8 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import inspect
-import math
-from collections.abc import Mapping
+import re
+from collections.abc import Callable, Mapping
 from typing import Any
 
 from planner.exceptions import ParameterError
@@ -75,6 +79,27 @@ DESCRIPTION_FIELDS = {
     "locked_joints": "names",
 }
 
+#: Description fields only the full robot in PyBullet reads (its physics, IK and fall
+#: rule); on ``--model lipm --robot NAME`` they would change nothing, so they are refused.
+PYBULLET_ONLY_FIELDS = frozenset(
+    {
+        "foot_spacing",
+        "fall_base_height",
+        "fall_tilt",
+        "swing_height",
+        "ground_friction",
+        "sole_spinning_friction",
+        "physics_time_step",
+        "solver_iterations",
+        "locked_joints",
+    }
+)
+
+#: Longest value text ``--set`` takes (a list of joint names fits).
+MAX_VALUE_LENGTH = 1000
+_NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?", re.ASCII)
+_INTEGER = re.compile(r"[+-]?\d{1,9}", re.ASCII)
+
 #: Backend keyword arguments that are not options of a run.
 _NOT_BACKEND_OPTIONS = {"self", "robot", "timing"}
 
@@ -97,14 +122,23 @@ def _paper_point_mass(model: str, robot: str | None) -> bool:
 
 
 def rsg_parameter_types(model: str = "pybullet", robot: str | None = None) -> dict[str, str]:
-    """RSG parameters ``--set`` may change on ``model`` -> ``"float"``: all of them on
-    the paper's LIPM; with a robot those its description does not set."""
+    """RSG parameters ``--set`` may change on ``model`` -> their kind (``"float"``,
+    ``"float | None"``): all of them on the paper's LIPM; with a robot those its
+    description does not set."""
     paper = _paper_point_mass(model, robot)
     return {
-        f.name: "float"
+        f.name: str(f.type)
         for f in dataclasses.fields(RsgParameters)
         if paper or (f.name not in DESCRIPTION_FIELDS and not f.name.startswith("lqr_"))
     }
+
+
+def description_field_types(model: str = "pybullet") -> dict[str, str]:
+    """Description fields ``--set`` may change on ``model`` (with a robot) -> their kind:
+    on the LIPM only those its planner reads."""
+    if model == "pybullet":
+        return dict(DESCRIPTION_FIELDS)
+    return {k: v for k, v in DESCRIPTION_FIELDS.items() if k not in PYBULLET_ONLY_FIELDS}
 
 
 def allowed_names(model: str = "pybullet", robot: str | None = None) -> list[str]:
@@ -113,7 +147,8 @@ def allowed_names(model: str = "pybullet", robot: str | None = None) -> list[str
     if _paper_point_mass(model, robot):
         return sorted(rsg_parameter_types("lipm", None))
     backend = backend_option_types() if model == "pybullet" else {}
-    return sorted({**DESCRIPTION_FIELDS, **backend, **rsg_parameter_types(model, robot)})
+    fields = description_field_types(model)
+    return sorted({**fields, **backend, **rsg_parameter_types(model, robot)})
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
@@ -139,7 +174,8 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
         metavar="NAME=VALUE",
         help="change one parameter: a robot description field, a PyBullet backend option "
         "or an RSG parameter, e.g. --set swing_preparation_time=0.3 --set cop_admittance=0.2 "
-        "(repeatable; a wrong name lists the allowed ones)",
+        "(repeatable; a wrong name lists the allowed ones, a value out of range gives the "
+        "range)",
     )
 
 
@@ -148,9 +184,36 @@ def parse_assignment(text: str) -> tuple[str, str]:
     name, sep, value = text.partition("=")
     if not sep or not name.strip() or not value.strip():
         raise argparse.ArgumentTypeError(
-            f"--set {text!r}: NAME=VALUE, e.g. --set swing_preparation_time=0.3"
+            f"--set {text[:60]!r}: NAME=VALUE, e.g. --set swing_preparation_time=0.3"
+        )
+    if len(value) > MAX_VALUE_LENGTH:
+        raise argparse.ArgumentTypeError(
+            f"--set {name.strip()[:60]}: a value of {len(value)} characters; at most "
+            f"{MAX_VALUE_LENGTH}"
         )
     return name.strip(), value.strip()
+
+
+def parse_decimal(text: str) -> float | None:
+    """``text`` as a finite decimal number (ASCII digits, no nan, inf, hex or ``_``), or
+    None."""
+    if not _NUMBER.fullmatch(text):
+        return None
+    value = float(text)
+    return value if abs(value) < float("inf") else None
+
+
+def decimal_argument(name: str) -> Callable[[str], float]:
+    """argparse type of a number option ``name``: :func:`parse_decimal`, or a one-line
+    error naming the option."""
+
+    def parse(text: str) -> float:
+        value = parse_decimal(text.strip())
+        if value is None:
+            raise argparse.ArgumentTypeError(f"{name}={text[:60]!r}: a finite decimal number")
+        return value
+
+    return parse
 
 
 def parse_value(name: str, text: str, kind: str) -> Any:
@@ -173,30 +236,27 @@ def parse_value(name: str, text: str, kind: str) -> Any:
         if lowered == "none":
             return ()
         names = tuple(part.strip() for part in text.split(","))
-        if not all(names):
-            raise ParameterError(f"--set {name}", text, "comma-separated names, or none")
+        if not all(re.fullmatch(r"[A-Za-z_][A-Za-z0-9_.-]*", n, re.ASCII) for n in names):
+            raise ParameterError(f"--set {name}", text, "comma-separated joint names, or none")
         return names
     if "str" in options:
         return text
     if "int" in options:
-        try:
-            return int(text)
-        except ValueError:
-            raise ParameterError(f"--set {name}", text, "an integer") from None
-    numbers = text.split(",")
-    try:
-        values = [float(part) for part in numbers]
-    except ValueError:
-        values = []
-    if values and all(math.isfinite(v) for v in values):
+        if not _INTEGER.fullmatch(text):
+            raise ParameterError(f"--set {name}", text, "an integer")
+        return int(text)
+    values = [parse_decimal(part.strip()) for part in text.split(",")]
+    if values and all(v is not None for v in values):
         if len(values) == 1 and "float" in options:
             return values[0]
         if len(values) == 2 and "tuple[float, float]" in options:
             return (values[0], values[1])
     wanted = " or ".join(
-        {"float": "a number", "tuple[float, float]": "two numbers a,b", "None": "none"}.get(
-            option, option
-        )
+        {
+            "float": "a finite decimal number",
+            "tuple[float, float]": "two numbers a,b",
+            "None": "none",
+        }.get(option, option)
         for option in options
     )
     raise ParameterError(f"--set {name}", text, wanted)
@@ -225,12 +285,14 @@ def parse_overrides(
 
     Raises:
         ParameterError: An unknown name (the message lists the allowed ones), a name
-            given twice, or a value of the wrong kind.
+            given twice, a setting that would do nothing on ``model``, or a value of
+            the wrong kind.
     """
     description: dict[str, Any] = {}
     backend: dict[str, Any] = {}
     rsg: dict[str, Any] = {}
     paper = _paper_point_mass(model, robot)
+    fields = {} if paper else description_field_types(model)
     backend_types = backend_option_types() if model == "pybullet" else {}
     rsg_types = rsg_parameter_types(model, robot)
     seen: set[str] = set()
@@ -238,22 +300,33 @@ def parse_overrides(
         if name in seen:
             raise ParameterError(f"--set {name}", text, "each name at most once")
         seen.add(name)
-        if not paper and name in DESCRIPTION_FIELDS:
-            description[name] = parse_value(name, text, DESCRIPTION_FIELDS[name])
+        if name in fields:
+            description[name] = parse_value(name, text, fields[name])
         elif name in backend_types:
             backend[name] = parse_value(name, text, backend_types[name])
         elif name in rsg_types:
             rsg[name] = parse_value(name, text, rsg_types[name])
+        elif model == "lipm" and (name in PYBULLET_ONLY_FIELDS or _is_backend_option(name)):
+            raise ParameterError(
+                f"--set {name}",
+                text,
+                "it only with --model pybullet: a setting of the full robot (its physics, "
+                "IK or fall rule), which the point mass does not have",
+            )
         else:
             if paper:
                 where = " (--model lipm: RSG parameters only)"
             elif model == "pybullet":
                 where = ""
             else:
-                where = " (--model lipm with a robot: no backend options)"
+                where = " (--model lipm with a robot: the planner's settings only)"
             allowed = ", ".join(allowed_names(model, robot))
-            raise ParameterError("--set", name, f"one of{where}: {allowed}")
+            raise ParameterError("--set", name[:60], f"one of{where}: {allowed}")
     return ParsedOverrides(description, backend, rsg)
+
+
+def _is_backend_option(name: str) -> bool:
+    return name in backend_option_types()
 
 
 def apply_to_description(
@@ -272,3 +345,132 @@ def apply_to_description(
 def apply_to_rsg(rsg: RsgParameters, parsed: ParsedOverrides) -> RsgParameters:
     """``rsg`` with the RSG parameters of ``parsed`` (validated by RsgParameters)."""
     return dataclasses.replace(rsg, **parsed.rsg) if parsed.rsg else rsg
+
+
+@dataclasses.dataclass(frozen=True)
+class RunSettings:
+    """What a run's settings give before its backend is built.
+
+    Attributes:
+        control_period: The loop's tick [s].
+        mass: The planner's mass [kg] (the description's on a robot; PyBullet measures
+            the robot's to within a few grams).
+    """
+
+    control_period: float
+    mass: float
+
+
+def check_overrides(
+    overrides: Overrides,
+    model: str = "pybullet",
+    robot: str | RobotDescription | None = None,
+    controller: str = "rsg",
+    paper: bool = False,
+) -> RunSettings:
+    """Check ``overrides`` the way a run would use them, without loading a robot: the
+    description with its fields, the PyBullet backend's options
+    (:func:`app.pybullet_backend.check_backend_options`), the planner's configuration
+    (after ``paper``, the paper's rules) and its Lyapunov design, and the swing foot's
+    timing. This is the one place that turns a range error into one that names the
+    ``--set`` given, its value and what is allowed (:func:`blame`).
+
+    Args:
+        overrides: ``--set`` pairs.
+        model, robot, controller: As on the command line (``robot`` None: G1 on
+            ``pybullet``, the paper's point mass on ``lipm``; or a description).
+        paper: ``--paper-rules``.
+
+    Returns:
+        The run's control period and mass.
+
+    Raises:
+        ParameterError: A bad override, named as the user wrote it; or a bad ``robot``.
+    """
+    if model == "pybullet" and robot is None:
+        from .setup import DEFAULT_ROBOT
+
+        robot = DEFAULT_ROBOT
+    description = None
+    if robot is not None:
+        from robots import get_robot
+
+        # An unknown robot is not the overrides' fault.
+        description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
+    parsed = parse_overrides(overrides, model, None if description is None else description.name)
+    try:
+        return _build_settings(parsed, model, description, controller, paper)
+    except ParameterError as exc:
+        if not overrides:
+            raise
+        raise blame(exc, overrides) from None
+
+
+def _build_settings(
+    parsed: ParsedOverrides,
+    model: str,
+    robot: RobotDescription | None,
+    controller: str,
+    paper: bool,
+) -> RunSettings:
+    """Build what a run builds from ``parsed`` (see :func:`check_overrides`)."""
+    from planner.lyapunov import design_lyapunov
+    from planner.parameters import PlannerConfig
+
+    from .lipm_backend import CONTROL_PERIOD
+    from .setup import paper_rules
+
+    if robot is None:
+        config = PlannerConfig(controller=controller)
+        period = CONTROL_PERIOD
+    else:
+        from .robot_setup import planner_config_for
+
+        description = apply_to_description(robot, parsed)
+        config = planner_config_for(description, description.total_mass, controller)
+        period = CONTROL_PERIOD
+        if model == "pybullet":
+            from kinematics.swing_foot import SwingTiming
+
+            from .pybullet_backend import DEFAULT_CONTROL_PERIOD, check_backend_options
+
+            check_backend_options(description, description.backend_options)
+            period = float(
+                description.backend_options.get("control_period", DEFAULT_CONTROL_PERIOD)
+            )
+    if paper:
+        config = paper_rules(config)
+    config = dataclasses.replace(config, rsg=apply_to_rsg(config.rsg, parsed))
+    design_lyapunov(config.model, config.constraints, config.rsg)
+    if model == "pybullet":
+        SwingTiming(
+            config.gait.double_support_duration,
+            config.rsg.swing_preparation_time,
+            config.gait.step_duration,
+        )
+    return RunSettings(period, config.model.mass)
+
+
+def blame(exc: ParameterError, overrides: Overrides) -> ParameterError:
+    """``exc``, raised while building with ``overrides``, as an error naming the
+    ``--set`` that caused it: the one whose name the error names, else the only one
+    given, else all of them together (a rule between two parameters)."""
+    given = dict(overrides)
+    if exc.field.startswith("--set"):
+        return exc
+    if exc.field in given:
+        return ParameterError(f"--set {exc.field}", given[exc.field], exc.allowed)
+    message = str(exc)
+    named = [
+        n for n in given if re.search(rf"(?<![A-Za-z0-9_]){re.escape(n)}(?![A-Za-z0-9_])", message)
+    ]
+    culprits = named or list(given)
+    because = f"{exc.field}={exc.value!r} to be {exc.allowed}"
+    if len(culprits) == 1:
+        name = culprits[0]
+        return ParameterError(f"--set {name}", given[name], f"a value that allows {because}")
+    return ParameterError(
+        "--set " + ", ".join(culprits),
+        tuple(given[n] for n in culprits),
+        f"values that together allow {because}",
+    )

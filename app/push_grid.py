@@ -37,10 +37,11 @@ from .capturability import impulse_bound
 from .overrides import Overrides
 from .scenarios import Scenario
 from .setup import resolve_robot
-from .sweep import JobProgress, build_controller, check_pushes, run_in_processes
+from .sweep import JobProgress, build_controller, check_pushes, check_workers, run_in_processes
 from .sweep_trial import push_timing
 
 OUTCOMES = ("recovered", "survived", "fell")
+MAX_IMPULSES = 100
 
 
 @dataclass(frozen=True)
@@ -81,10 +82,14 @@ class GridSpec:
         check_pushes(
             self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
         )
-        if not self.impulses or not all(
-            math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses
+        if not (
+            0 < len(self.impulses) <= MAX_IMPULSES
+            and all(math.isfinite(i) and 0.0 < i <= 1000.0 for i in self.impulses)
+            and len(set(self.impulses)) == len(self.impulses)
         ):
-            raise ParameterError("impulses", self.impulses, "impulses in (0, 1000] N s")
+            raise ParameterError(
+                "impulses", self.impulses, f"1 to {MAX_IMPULSES} distinct impulses in (0, 1000] N s"
+            )
         if not (math.isfinite(self.duration) and 1e-3 <= self.duration <= 1.0):
             raise ParameterError("duration", self.duration, "a number in [0.001, 1] s")
         if not (math.isfinite(self.settle) and 1.0 <= self.settle <= 60.0):
@@ -165,8 +170,7 @@ def run_grid(spec: GridSpec, workers: int = 1, progress: bool = True) -> list[di
     Raises:
         ParameterError: Bad ``workers``.
     """
-    if not (isinstance(workers, int) and 1 <= workers <= 1024):
-        raise ParameterError("--workers", workers, "an integer in [1, 1024]")
+    check_workers(workers)
     jobs = all_grid_jobs(spec)
     bar = JobProgress(len(jobs), 0, progress, label="grid", unit="runs")
     records: dict[GridJob, dict] = {}

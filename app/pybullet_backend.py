@@ -145,7 +145,7 @@ from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError, RsgError
 from planner.hybrid_lipm import integrate_lipm
-from planner.parameters import LipmModel
+from planner.parameters import LipmModel, Range
 from planner.types import Foot, MeasuredState, PlannerOutput, Vector2, other_foot
 from robots import get_robot
 from robots.description import RobotDescription
@@ -156,6 +156,97 @@ SWING_FEEDBACK_LIMIT = 0.05  # bound on the swing sole's measured offset [m]
 SWING_TILT_LIMIT = 0.2  # bound on the swing sole's measured roll and pitch error [rad]
 CONTACT_LOAD_FRACTION = 0.3  # swing-sole load [-, of m g] that counts as a touchdown
 CONTACT_WINDOW = 0.08  # [s] before the planned step in which a touchdown switches the stance
+DEFAULT_CONTROL_PERIOD = 0.01  # [s]
+
+
+#: Numeric options of :class:`PyBulletBackend` and the range in which each means
+#: something on a humanoid (see the constructor's docstring for what each does).
+OPTION_RANGES: dict[str, Range] = {
+    # G1 walks 10 s nominally at 4 to 12 ms; it fell at 14, 16 and 20 ms (docs/notes).
+    "control_period": Range(0.002, 0.012, "s"),
+    "com_lookahead": Range(0.0, 0.5, "s"),
+    "com_reference_blend": Range(0.0, 1.0),
+    "arrival_lead": Range(0.0, 0.5, "s"),
+    "touchdown_lead": Range(0.0, 0.2, "s"),
+    "touchdown_depth": Range(0.0, 0.02, "m"),
+    "transfer_lift": Range(0.0, 0.02, "m"),
+    "transfer_ramp": Range(0.0, 1.0, "s", low_open=True),
+    "momentum_compensation": Range(0.0, 1.0),
+    "momentum_filter": Range(0.0, 1.0, "s", low_open=True),
+    "touchdown_speed": Range(0.0, 0.5, "m/s"),
+    "landing_delay": Range(0.0, 0.05, "s"),
+    "landing_clearance": Range(0.0, 0.01, "m"),
+    "swing_acceleration": Range(0.0, 1000.0, "m/s^2", low_open=True),
+    "swing_descent_slope": Range(0.0, 10.0),
+    "cop_admittance": Range(0.0, 2.0),
+    "upper_body_momentum": Range(0.0, 10.0, "N m s"),
+    "upper_body_return_time": Range(0.0, 10.0, "s", low_open=True),
+    "upper_body_cancel": Range(0.0, 1.0),
+    "reanchor_min": Range(0.0, 0.1, "m"),
+    "swing_feedback": Range(0.0, 1.0),
+    "swing_feedback_filter": Range(0.0, 1.0, "s", low_open=True),
+    "swing_level_feedback": Range(0.0, 1.0),
+}
+#: Options given as one number or a pair (forward, lateral): the range of each.
+PAIR_RANGES: dict[str, tuple[Range, Range]] = {
+    "com_tracking_gains": (Range(0.0, 10.0), Range(0.0, 1.0, "s")),
+    "landing_correction": (Range(0.0, 1.0), Range(0.0, 1.0)),
+    "cop_feedback": (Range(0.0, 50.0, "rad/(m s)"), Range(0.0, 50.0, "rad/(m s)")),
+}
+OPTION_CHOICES = {
+    "plan_angular_momentum": ("full", "feedback", "none"),
+    "stance_switch": ("planned", "contact"),
+}
+
+
+def check_backend_options(description: RobotDescription, options: Mapping[str, object]) -> None:
+    """Check the backend ``options`` (keyword arguments of :class:`PyBulletBackend`) for
+    ``description``, without loading anything: each number in its range, each word
+    among its choices, each flag a bool, and the control period a whole multiple of the
+    robot's physics step.
+
+    Raises:
+        ParameterError: Naming the option, its value and what is allowed.
+    """
+    for name, value in options.items():
+        if name == "cop_margin" or (value is None and name == "swing_acceleration"):
+            continue  # cop_margin: against the sole, below
+        if name in OPTION_RANGES:
+            OPTION_RANGES[name].check(name, value)
+        elif name in PAIR_RANGES:
+            ranges = PAIR_RANGES[name]
+            pair = (value, value) if isinstance(value, int | float) else value
+            parts: tuple = tuple(pair) if isinstance(pair, tuple | list) else ()
+            if len(parts) != 2 or not all(
+                r.contains(v) for r, v in zip(ranges, parts, strict=True)
+            ):
+                allowed = " and ".join(r.describe().removeprefix("a number ") for r in ranges)
+                raise ParameterError(name, value, f"one number or a pair a,b: {allowed}")
+        elif name in OPTION_CHOICES:
+            if value not in OPTION_CHOICES[name]:
+                raise ParameterError(name, value, " or ".join(OPTION_CHOICES[name]))
+        elif not isinstance(value, bool):
+            raise ParameterError(name, value, "true or false")
+    physics_step = description.physics_time_step
+    control_period = float(options.get("control_period", DEFAULT_CONTROL_PERIOD))  # type: ignore[arg-type]
+    substeps = round(control_period / physics_step)
+    if substeps < 1 or abs(substeps * physics_step - control_period) > 1e-9:
+        raise ParameterError(
+            "control_period/physics_time_step",
+            (control_period, physics_step),
+            "a control period that is a whole multiple of the physics step [s]",
+        )
+    cop_margin = options.get("cop_margin", 0.01)
+    half_width = description.sole.half_width
+    if not (isinstance(cop_margin, int | float) and 0.0 <= cop_margin < half_width):
+        raise ParameterError("cop_margin", cop_margin, f"a number in [0, {half_width:g}) m")
+    momentum = options.get("upper_body_momentum", 0.0)
+    if momentum and not description.upper_body_joints:  # type: ignore[truthy-bool]
+        raise ParameterError(
+            "upper_body_momentum",
+            momentum,
+            f"0 for {description.name}, whose description lists no upper_body_joints",
+        )
 
 
 class PyBulletBackend:
@@ -174,7 +265,7 @@ class PyBulletBackend:
     def __init__(
         self,
         robot: str | RobotDescription = "g1",
-        control_period: float = 0.01,
+        control_period: float = DEFAULT_CONTROL_PERIOD,
         timing: SwingTiming | None = None,
         com_lookahead: float = 0.0,
         com_reference_blend: float = 0.0,
@@ -322,54 +413,20 @@ class PyBulletBackend:
                 when the body leans (after a push the stance foot rolls onto an edge
                 and the swing foot comes down early).
         """
+        options = {k: v for k, v in locals().items() if k not in ("self", "robot", "timing")}
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
+        check_backend_options(self.description, options)
         # Welded in the physics: not measured, shown at the angle they are welded at.
         self._locked_angles = locked_angles(self.description)
-        physics_step = self.description.physics_time_step
-        substeps = round(control_period / physics_step)
-        if substeps < 1 or abs(substeps * physics_step - control_period) > 1e-9:
-            raise ParameterError(
-                "control_period/physics_time_step",
-                (control_period, physics_step),
-                "a control period that is a whole multiple of the physics step [s]",
-            )
         self.control_period = control_period
-        self._substeps = substeps
-        if not com_lookahead >= 0.0:
-            raise ParameterError("com_lookahead", com_lookahead, ">= 0 s")
-        if not 0.0 <= com_reference_blend <= 1.0:
-            raise ParameterError("com_reference_blend", com_reference_blend, "in [0, 1]")
+        self._substeps = round(control_period / self.description.physics_time_step)
         self.com_lookahead = com_lookahead
         self.com_reference_blend = com_reference_blend
         self.com_tracking_gains = com_tracking_gains
         self.interpolate_targets = interpolate_targets
-        if not (0.0 <= touchdown_lead <= 0.2 and 0.0 <= touchdown_depth <= 0.02):
-            raise ParameterError(
-                "touchdown_lead/touchdown_depth",
-                (touchdown_lead, touchdown_depth),
-                "lead in [0, 0.2] s and depth in [0, 0.02] m",
-            )
         self.touchdown_lead = touchdown_lead
-        if plan_angular_momentum not in ("full", "feedback", "none"):
-            raise ParameterError(
-                "plan_angular_momentum", plan_angular_momentum, "full, feedback or none"
-            )
         self.plan_angular_momentum = plan_angular_momentum
         self.touchdown_depth = touchdown_depth
-        if not (0.0 <= transfer_lift <= 0.02 and transfer_ramp > 0.0):
-            raise ParameterError(
-                "transfer_lift/transfer_ramp",
-                (transfer_lift, transfer_ramp),
-                "lift in [0, 0.02] m and ramp > 0 s",
-            )
-        if not (0.0 <= momentum_compensation <= 1.0 and momentum_filter > 0.0):
-            raise ParameterError(
-                "momentum_compensation/momentum_filter",
-                (momentum_compensation, momentum_filter),
-                "compensation in [0, 1] and filter > 0 s",
-            )
-        if not 0.0 <= cop_margin < self.description.sole.half_width:
-            raise ParameterError("cop_margin", cop_margin, "in [0, sole half width) m")
         self.transfer_lift = transfer_lift
         self.transfer_ramp = transfer_ramp
         self.momentum_compensation = momentum_compensation
@@ -382,50 +439,24 @@ class PyBulletBackend:
         self._stance_offset = np.zeros(2)  # measured stance sole - o_H [m]
         self.yaw_feedback = yaw_feedback
         self.reanchor_stance = reanchor_stance
-        if not 0.0 <= reanchor_min <= 0.1:
-            raise ParameterError("reanchor_min", reanchor_min, "in [0, 0.1] m")
         self.reanchor_min = reanchor_min
         self._report_stance = False
-        if not (0.0 <= swing_feedback <= 1.0 and 0.0 < swing_feedback_filter <= 1.0):
-            raise ParameterError(
-                "swing_feedback/swing_feedback_filter",
-                (swing_feedback, swing_feedback_filter),
-                "gain in [0, 1] and filter in (0, 1] s",
-            )
         self.swing_feedback = swing_feedback
         self.swing_feedback_filter = swing_feedback_filter
         self._swing_offset = np.zeros(2)  # real - IK swing sole, relative to stance [m]
-        if not 0.0 <= swing_level_feedback <= 1.0:
-            raise ParameterError("swing_level_feedback", swing_level_feedback, "in [0, 1]")
         self.swing_level_feedback = swing_level_feedback
         self._swing_sag = 0.0  # IK - real lowest swing sole corner height [m]
         self._swing_tilt = np.zeros(2)  # real - IK swing sole roll, pitch [rad]
         self._frame_yaw = 0.0  # measured stance yaw - the IK's [rad]
         self._ik_yaw = {"left": 0.0, "right": 0.0}  # soles' yaw in the IK [rad]
         self.ankle = AnkleCopFeedback(cop_feedback)
-        if not 0.0 <= cop_admittance <= 2.0:
-            raise ParameterError("cop_admittance", cop_admittance, "in [0, 2]")
         self.cop_admittance = cop_admittance
-        if stance_switch not in ("planned", "contact"):
-            raise ParameterError("stance_switch", stance_switch, "planned or contact")
         self.stance_switch = stance_switch
-        if not 0.0 <= upper_body_momentum <= 10.0:
-            raise ParameterError("upper_body_momentum", upper_body_momentum, "in [0, 10] N m s")
-        if not 0.0 < upper_body_return_time <= 10.0:
-            raise ParameterError("upper_body_return_time", upper_body_return_time, "in (0, 10] s")
-        if upper_body_momentum > 0.0 and not self.description.upper_body_joints:
-            raise ParameterError(
-                "upper_body_momentum",
-                upper_body_momentum,
-                f"0 for {self.description.name}, whose description lists no upper_body_joints",
-            )
         self._last_command: PlannerOutput | None = None
         #: Set to a :class:`app.physics_log.PhysicsLog` to record every physics step.
         self.physics_log: PhysicsLog | None = None
         self._plan_cop = np.zeros(2)  # CoP of the CoM plan over the last tick [m]
         self._pressure: dict[str, tuple[NDArray[np.float64], float]] = {}
-        if not 0.0 <= landing_clearance <= 0.01:
-            raise ParameterError("landing_clearance", landing_clearance, "in [0, 0.01] m")
         self.landing_clearance = landing_clearance
         self._com_reference = np.zeros(2)
         self._com_velocity_reference = np.zeros(2)
@@ -473,8 +504,6 @@ class PyBulletBackend:
             descent_slope=swing_descent_slope,
             land_on_time=swing_land_on_time,
         )
-        if not 0.0 <= landing_delay <= 0.05:
-            raise ParameterError("landing_delay", landing_delay, "in [0, 0.05] s")
         self.landing_delay = landing_delay
 
         self.timers: dict[str, float] = defaultdict(float)

@@ -11,13 +11,39 @@ import numpy as np
 from planner.exceptions import RsgError
 
 from .runner import TIMESERIES_COLUMNS, RunResult
+from .scenarios import delivered_fraction
+
+
+def pushes_of(result: RunResult) -> tuple[list[dict], list[dict]]:
+    """The scenario's pushes split into those that acted with their whole impulse and
+    those that did not: cut short by a fall or an interruption (with the impulse they
+    did deliver), or left out by ``--duration`` (``extra["pushes_left_out"]``)."""
+    applied, cut = [], []
+    end = result.sim_time
+    if result.interrupted:
+        why = f"the run was interrupted at t={end:g} s"
+    else:
+        why = f"the run ended at t={end:g} s ({result.fall.reason or 'fell'})"
+    for push in result.scenario.pushes:
+        fraction = delivered_fraction(push, end)
+        if fraction >= 1.0:
+            applied.append(push.as_dict())
+        else:
+            delivered = [float(v) * fraction for v in push.impulse]
+            cut.append({**push.as_dict(), "impulse_applied": delivered, "reason": why})
+    for push in result.extra.get("pushes_left_out", ()):
+        reason = f"it starts after the end of the run (--duration {result.scenario.duration:g} s)"
+        cut.append({**push.as_dict(), "impulse_applied": [0.0, 0.0], "reason": reason})
+    return applied, cut
 
 
 def summary_of(result: RunResult, controller: str) -> dict:
     """The run's summary as a JSON-ready dict (see the README for each field)."""
     config = result.config
+    applied, cut = pushes_of(result)
     return {
         "recovered": bool(result.recovered),
+        "interrupted": bool(result.interrupted),
         "fell": bool(result.fall.fell),
         "fall_reason": result.fall.reason,
         "model": result.backend,
@@ -35,7 +61,8 @@ def summary_of(result: RunResult, controller: str) -> dict:
             if result.impulse_scale != 1.0
             else ""
         ),
-        "pushes": [p.as_dict() for p in result.scenario.pushes],
+        "pushes": applied,
+        "pushes_not_applied": cut,
         "steps": [dict(s.event, step=s.step) for s in result.steps],
         "adjusted_steps": int(sum(s.event["adjusted"] for s in result.steps)),
         "qp_infeasible": int(result.qp_infeasible),
@@ -70,12 +97,17 @@ def summary_of(result: RunResult, controller: str) -> dict:
             "lyapunov_matrix": result.extra.get("lyapunov_matrix"),
             "feedback_gain": result.extra.get("feedback_gain"),
         },
-        **{k: v for k, v in result.extra.items() if k not in ("lyapunov_matrix", "feedback_gain")},
+        **{
+            k: v
+            for k, v in result.extra.items()
+            if k not in ("lyapunov_matrix", "feedback_gain", "pushes_left_out")
+        },
     }
 
 
 def write_results(result: RunResult, controller: str, out_dir: Path, plots: bool = True) -> dict:
-    """Write summary.json, timeseries.csv and (optionally) PNG plots into ``out_dir``.
+    """Write summary.json, timeseries.csv and (optionally, with two ticks or more) PNG
+    plots into ``out_dir`` (checked beforehand by :func:`app.result_folder.prepare_out`).
 
     Returns:
         The summary dict.
@@ -97,7 +129,7 @@ def write_results(result: RunResult, controller: str, out_dir: Path, plots: bool
         )
     except OSError as exc:
         raise RsgError(f"cannot write results to {out_dir}: {exc}") from exc
-    if plots:
+    if plots and len(result.timeseries) >= 2:
         from .plots import plot_fig6
 
         plot_fig6(result, out_dir)

@@ -21,6 +21,7 @@ from .overrides import (
     ParsedOverrides,
     apply_to_description,
     apply_to_rsg,
+    check_overrides,
     parse_overrides,
 )
 from .runner import walking_start
@@ -105,6 +106,7 @@ def build_robot_backend(  # noqa: ANN201
     from .pybullet_backend import PyBulletBackend
     from .setup import paper_rules
 
+    check_overrides(overrides, "pybullet", robot, controller, paper)
     description, parsed = robot_with_overrides(robot, overrides)
     backend = PyBulletBackend(description, **description.backend_options)
     config = planner_config_for(description, backend.mass, controller)

@@ -4,14 +4,20 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
 
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
+from planner.types import Push
 
+from .overrides import check_overrides
+from .result_folder import prepare_out
 from .results import write_results
 from .runner import RunResult, run_closed_loop
-from .scenarios import load_scenario
+from .scenarios import describe_push, load_scenario
 from .setup import DEFAULT_ROBOT, build_backend, resolve_robot
 
 
@@ -36,10 +42,16 @@ class ProgressBar:
             sys.stderr.flush()
 
 
+#: Exit code of a run stopped by Ctrl-C (128 + SIGINT, the shells' convention).
+EXIT_INTERRUPTED = 130
+
+
 def verdict(result: RunResult) -> str:
     """One line saying what happened."""
     adjusted = sum(s.event["adjusted"] for s in result.steps)
     head = "RECOVERED" if result.recovered else ("FELL" if result.fall.fell else "NOT RECOVERED")
+    if result.interrupted:
+        head = f"INTERRUPTED at t={result.sim_time:.3f} s (results so far written)"
     why = f" ({result.fall.reason})" if result.fall.fell else ""
     return (
         f"{head}{why}: {len(result.steps)} steps ({adjusted} adjusted), "
@@ -51,27 +63,49 @@ def verdict(result: RunResult) -> str:
 
 
 def run_command(args: argparse.Namespace) -> int:
-    """Run ``args.scenario``; returns 0 if recovered, 1 otherwise."""
-    scenario = load_scenario(args.scenario).with_pushes(args.push)
-    if args.duration is not None:
-        scenario = type(scenario)(
-            scenario.name,
-            args.duration,
-            scenario.pushes,
-            scenario.description,
-            scenario.reference_mass,
-        )
+    """Run ``args.scenario``; returns 0 if recovered, 1 if not, 130 if interrupted.
+
+    Everything is checked before the backend is built: the scenario and pushes
+    (:mod:`app.scenarios`), the overrides (:func:`app.overrides.check_overrides`), that
+    the scenario fits the loop's tick, and the ``--out`` folder
+    (:func:`app.result_folder.prepare_out`).
+    """
+    scenario = load_scenario(args.scenario)
+    left_out: list[Push] = []
+    if args.duration is not None:  # shortens the scenario: its later pushes are left out
+        left_out = [p for p in scenario.pushes if p.time >= args.duration]
+        kept = tuple(p for p in scenario.pushes if p.time < args.duration)
+        scenario = replace(scenario, duration=args.duration, pushes=kept)
+    scenario = scenario.with_pushes(args.push)  # each must end before the run does
     planner = None
     overrides = tuple(args.overrides)
     robot = resolve_robot(args.model, args.robot)
-    if args.controller == "placo-wpg":
-        if args.model != "pybullet":
-            raise ParameterError(
-                "--controller",
-                "placo-wpg",
-                "--model pybullet with placo-wpg (it drives the full robot's IK), or one of "
-                f"{', '.join(CONTROLLERS)} on --model {args.model}",
-            )
+    wpg = args.controller == "placo-wpg"
+    if wpg and args.model != "pybullet":
+        raise ParameterError(
+            "--controller",
+            "placo-wpg",
+            "--model pybullet with placo-wpg (it drives the full robot's IK), or one of "
+            f"{', '.join(CONTROLLERS)} on --model {args.model}",
+        )
+    if wpg and args.paper_rules:
+        raise ParameterError(
+            "--paper-rules", True, "no --paper-rules with placo-wpg (they are rules of the RSG)"
+        )
+    if args.physics_log and args.model != "pybullet":
+        raise ParameterError(
+            "--model", args.model, "pybullet with --physics-log (the LIPM has no physics steps)"
+        )
+    settings = check_overrides(
+        overrides, args.model, robot, "rsg" if wpg else args.controller, args.paper_rules
+    )
+    scenario.check_fits(settings.control_period)
+    scenario.scaled_to(settings.mass)  # the impulses' bound, with the nominal mass
+    for path in prepare_out(args.out, "run", args.overwrite):
+        print(f"deleted {path} (--overwrite)")
+    for push in left_out:
+        print(f"left out: {describe_push(push)} of {scenario.name} starts after --duration")
+    if wpg:
         from .placo_wpg import build_placo_wpg_backend
 
         backend, config, initial, planner = build_placo_wpg_backend(
@@ -83,11 +117,6 @@ def run_command(args: argparse.Namespace) -> int:
         )
     physics_log = None
     if args.physics_log:
-        if not hasattr(backend, "physics_log"):
-            backend.close()
-            raise ParameterError(
-                "--model", args.model, "pybullet with --physics-log (the LIPM has no physics steps)"
-            )
         from .physics_log import PhysicsLog
 
         physics_log = backend.physics_log = PhysicsLog()
@@ -100,15 +129,16 @@ def run_command(args: argparse.Namespace) -> int:
                 f"impulses scaled by {factor:.3f} (robot mass {backend.mass:.1f} kg / "
                 f"{scenario.reference_mass:.1f} kg) so the velocity change matches"
             )
+        bar = ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet)
         result = run_closed_loop(
-            backend,
-            config,
-            scaled,
-            initial,
-            progress=ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet),
-            planner=planner,
+            backend, config, scaled, initial, progress=bar, planner=planner, interruptible=True
         )
+        if result.interrupted and bar.enabled:
+            sys.stderr.write("\n")  # end the bar's line
         result.impulse_scale = factor
+        result.extra["pushes_left_out"] = [
+            Push(p.time, np.asarray(p.impulse, dtype=float) * factor, p.duration) for p in left_out
+        ]
         if robot is not None:
             result.extra["robot"] = robot
         description = getattr(backend, "description", None)
@@ -125,7 +155,9 @@ def run_command(args: argparse.Namespace) -> int:
         print(f"wrote {out / name}")
     if physics_log is not None:
         print(f"wrote {physics_log.write(out / 'physics.csv')}")
-    if not args.no_plots:
+    if not args.no_plots and len(result.timeseries) >= 2:
         print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
     print(verdict(result))
+    if result.interrupted:
+        return EXIT_INTERRUPTED
     return 0 if summary["recovered"] else 1

@@ -11,8 +11,11 @@ Constraints are checked here, independently of how the planner enforces them:
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import threading
 import time as wallclock
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -83,6 +86,8 @@ class RunResult:
         qp_infeasible: Number of steps where (27) fell back.
         sim_time: Simulated time [s]; wall_time: [s].
         impulse_scale: Factor applied to the scenario's impulses.
+        interrupted: The run was stopped (Ctrl-C) before its end: what it holds is
+            what was simulated until then.
     """
 
     config: PlannerConfig
@@ -100,6 +105,7 @@ class RunResult:
     impulse_scale: float = 1.0
     lyapunov_threshold: float = 0.0
     extra: dict = field(default_factory=dict)
+    interrupted: bool = False
 
     def column(self, name: str) -> np.ndarray:
         """One column of the time series."""
@@ -119,10 +125,12 @@ class RunResult:
 
     @property
     def recovered(self) -> bool:
-        """No fall, V_u below gamma_v at the end, and the last two steps nominal."""
+        """No fall, V_u below gamma_v at the end, and the last two steps nominal (never
+        for an interrupted run)."""
         last = self.steps[-2:]
         return (
-            not self.fall.fell
+            not self.interrupted
+            and not self.fall.fell
             and self.final_lyapunov < self.lyapunov_threshold
             and len(last) == 2
             and not any(s.event["adjusted"] for s in last)
@@ -257,7 +265,9 @@ class ClosedLoop:
                 self.violations[name] += 1
         for name in _check_tick(self.config, out, measured.com_position):
             self.violations[name] += 1
-        force = self.scenario.force_average(time, self.period)
+        # The tick's mean push force: its impulse over [t_k, t_k+1), exact for any push.
+        end = (self.ticks + 1) * self.period
+        force = self.scenario.impulse_between(time, end) / self.period
         if self.ticks >= len(self.rows):
             self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
         self.rows[self.ticks] = (
@@ -304,6 +314,7 @@ def run_closed_loop(
     progress: Callable[[float], None] | None = None,
     qp_solver: str = "proxqp",
     planner: PlannerFactory | None = None,
+    interruptible: bool = False,
 ) -> RunResult:
     """Run ``scenario`` with the planner of ``config`` on ``backend``.
 
@@ -315,19 +326,57 @@ def run_closed_loop(
         progress: Called with the fraction done, about 100 times a run.
         qp_solver: ``"proxqp"`` or ``"exact"`` for the QP (27).
         planner: Builds another planner than the RSG (see :class:`ClosedLoop`).
+        interruptible: Ctrl-C (SIGINT) stops the run at the end of the current tick
+            and returns what was simulated, marked ``interrupted``; a second Ctrl-C
+            raises KeyboardInterrupt at once. Only in the main thread.
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.
+
+    Raises:
+        ParameterError: The scenario does not fit the loop (:meth:`Scenario.check_fits`).
     """
+    ticks = scenario.check_fits(backend.control_period)
     loop = ClosedLoop(backend, config, scenario, initial, qp_solver, planner=planner)
-    ticks = int(round(scenario.duration / loop.period))
     report_every = max(1, ticks // 100)
-    for tick in range(ticks):
-        loop.tick()
-        if progress is not None and tick % report_every == 0:
-            progress(tick / ticks)
-        if backend.fall_status().fell:
-            break
-    if progress is not None:
+    with _stop_on_sigint(interruptible) as stop:
+        for tick in range(ticks):
+            if stop.requested:
+                break
+            loop.tick()
+            if progress is not None and tick % report_every == 0:
+                progress(tick / ticks)
+            if backend.fall_status().fell:
+                break
+    if progress is not None and not stop.requested:
         progress(1.0)
-    return loop.result()
+    result = loop.result()
+    result.interrupted = stop.requested
+    return result
+
+
+class _StopRequest:
+    """Set by the SIGINT handler of :func:`_stop_on_sigint`."""
+
+    requested = False
+
+
+@contextlib.contextmanager
+def _stop_on_sigint(enabled: bool) -> Iterator[_StopRequest]:
+    """While active (``enabled``, main thread), the first SIGINT sets ``requested``
+    instead of raising; a second one raises KeyboardInterrupt."""
+    stop = _StopRequest()
+    if not enabled or threading.current_thread() is not threading.main_thread():
+        yield stop
+        return
+
+    def handler(signum: int, frame: object) -> None:
+        if stop.requested:
+            raise KeyboardInterrupt
+        stop.requested = True
+
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield stop
+    finally:
+        signal.signal(signal.SIGINT, previous)

@@ -10,7 +10,7 @@ from planner.parameters import PlannerConfig
 
 from .backend import Backend, InitialCondition
 from .lipm_backend import LipmBackend
-from .overrides import Overrides, apply_to_rsg, parse_overrides
+from .overrides import Overrides, apply_to_rsg, check_overrides, parse_overrides
 from .runner import walking_start
 
 DEFAULT_ROBOT = "g1"
@@ -58,6 +58,9 @@ def build_backend(
     Raises:
         ParameterError: Unknown model or robot, or a bad override.
     """
+    if model not in ("lipm", "pybullet"):
+        raise ParameterError("--model", model, "lipm or pybullet")
+    check_overrides(overrides, model, robot, controller, paper)
     if model == "lipm":
         if robot is None:
             parsed = parse_overrides(overrides, "lipm")

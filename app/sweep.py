@@ -15,16 +15,28 @@ Directions: n directions at angle 2 pi i / n in the world frame, 0 = forward (+x
 90 deg = to the left (+y).
 
 Workers: jobs run in worker processes (``concurrent.futures``) or on a Ray cluster
-(``backend="ray"``, :mod:`app.sweep_ray`). Every finished job is appended to
-``jobs.jsonl`` in the output folder at once; a sweep started again on the same
-folder skips the jobs found there, so an interrupted sweep resumes where it stopped.
+(``backend="ray"``, :mod:`app.sweep_ray`); at most :func:`max_workers` and never more
+than there are jobs. A worker process ends when the process that started it does
+(:func:`_die_with_parent`), so a killed sweep (SIGKILL) leaves no orphans behind.
+
+Resume: every finished job is appended to ``jobs.jsonl`` in the output folder at once;
+a sweep started again on the same folder skips the jobs found there, so an interrupted
+sweep resumes where it stopped. The folder's ``sweep_spec.json`` must be one written by
+``rsg sweep`` with the same result-defining settings and every line of ``jobs.jsonl`` a
+job record of it, else the folder is refused (with the way out: another ``--out``, or
+``--overwrite`` to start over); an unfinished last line (a sweep killed while writing
+it) is dropped and its job runs again.
 """
 
 from __future__ import annotations
 
+import ctypes
 import json
 import math
+import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -40,7 +52,8 @@ from planner.types import Push
 
 from .bisection import bisect_threshold
 from .capturability import impulse_bound
-from .overrides import Overrides, parse_overrides
+from .overrides import Overrides, check_overrides
+from .result_folder import RESULT_FILES, ResultFolderError, prepare_out
 from .scenarios import Scenario
 from .setup import DEFAULT_ROBOT, resolve_robot
 from .sweep_trial import SettledTrial, push_timing
@@ -68,6 +81,24 @@ class GridLike(Protocol):
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
 JOBS_FILE = "jobs.jsonl"
 SPEC_FILE = "sweep_spec.json"
+MAX_PHASES = 100
+MAX_RAY_WORKERS = 1024
+PARENT_POLL_PERIOD = 0.5  # [s] how often a worker checks that its parent still runs
+START_OVER = "use another --out, or add --overwrite to start the sweep over"
+#: A job record's fields and their types (what the envelope and its plot read).
+RECORD_FIELDS: dict[str, type | tuple[type, ...]] = {
+    "key": str,
+    "controller": str,
+    "direction_deg": (int, float),
+    "phase": (int, float),
+    "impulse": (int, float),
+    "bound": (int, float),
+    "ratio": (int, float),
+    "capped": bool,
+    "runs": int,
+    "stance": str,
+    "push_time": (int, float),
+}
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
@@ -101,15 +132,18 @@ def check_pushes(
             "placo-wpg only with --model pybullet (it drives the full robot's IK; "
             "on the LIPM it has no meaning)",
         )
-    if not (isinstance(directions, int) and 1 <= directions <= 360):
+    if isinstance(directions, bool) or not (isinstance(directions, int) and 1 <= directions <= 360):
         raise ParameterError("directions", directions, "an integer in [1, 360]")
-    if not phases or not all(0.0 <= p < 1.0 for p in phases):
-        raise ParameterError("phases", phases, "fractions in [0, 1)")
-    if robot is not None:
-        from robots import get_robot
-
-        get_robot(robot)
-    parse_overrides(overrides, model, robot)
+    if not (
+        0 < len(phases) <= MAX_PHASES
+        and all(isinstance(p, float | int) and 0.0 <= p < 1.0 for p in phases)
+        and len(set(phases)) == len(phases)
+    ):
+        raise ParameterError(
+            "phases", phases, f"1 to {MAX_PHASES} distinct fractions in [0, 1) of the cycle"
+        )
+    for controller in controllers:  # every range, before any worker starts
+        check_overrides(overrides, model, robot, "rsg" if controller == PLACO_WPG else controller)
 
 
 @dataclass(frozen=True)
@@ -315,14 +349,21 @@ class JobProgress:
 
 
 def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
-    """Jobs already finished in ``out`` (resume); checks the spec agrees.
+    """Jobs already finished in ``out`` (resume); checks the folder's files.
 
     Raises:
         ParameterError: The folder holds a sweep with other result-defining settings.
+        ResultFolderError: ``sweep_spec.json`` or ``jobs.jsonl`` is not one ``rsg sweep``
+            wrote (not UTF-8 JSON, not a specification, a line that is not a job record,
+            a folder), or ``jobs.jsonl`` has no specification beside it.
     """
-    spec_path = out / SPEC_FILE
-    if spec_path.is_file():
-        old = json.loads(spec_path.read_text())
+    spec_path, jobs_path = out / SPEC_FILE, out / JOBS_FILE
+    if os.path.lexists(jobs_path) and not os.path.lexists(spec_path):
+        raise ResultFolderError(
+            jobs_path, f"has no {SPEC_FILE} beside it to check its jobs against", START_OVER
+        )
+    if os.path.lexists(spec_path):
+        old = _read_spec(spec_path)
         # Tuples as JSON lists, as stored.
         new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, SweepSpec()))
         for name in RESULT_FIELDS:  # a field missing from an older spec had its default
@@ -332,18 +373,90 @@ def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
                     f"--out {out} ({name})",
                     asdict(spec)[name],
                     f"the same {name} as the sweep stored there ({stored!r}), "
-                    "or a new --out folder",
+                    "or a new --out folder, or --overwrite to start that sweep over",
                 )
+    if not os.path.lexists(jobs_path):
+        return {}
+    return _read_jobs(jobs_path)
+
+
+def _read_spec(path: Path) -> dict:
+    """The stored specification (a JSON object with SweepSpec's fields)."""
+    try:
+        old = json.loads(path.read_bytes().decode("utf-8"))
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) else type(exc).__name__
+        raise ResultFolderError(
+            path, f"is not a sweep specification rsg sweep wrote ({reason})", START_OVER
+        ) from None
+    known = set(asdict(SweepSpec()))
+    if not isinstance(old, dict) or "model" not in old or not set(old) <= known:
+        raise ResultFolderError(
+            path, "is not a sweep specification rsg sweep wrote (other fields)", START_OVER
+        )
+    return old
+
+
+def _read_jobs(path: Path) -> dict[str, dict]:
+    """The records of ``jobs.jsonl``; an unfinished last line (no newline: the sweep was
+    killed while writing it) is dropped from the file, with a note on stderr."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ResultFolderError(path, f"cannot be read ({exc.strerror})", START_OVER) from None
+    lines = data.split(b"\n")
+    complete, last = lines[:-1], lines[-1]
     finished: dict[str, dict] = {}
-    jobs_path = out / JOBS_FILE
-    if jobs_path.is_file():
-        for line in jobs_path.read_text().splitlines():
-            try:
-                record = json.loads(line)
-            except json.JSONDecodeError:
-                continue  # a line cut by an interruption
+    for number, line in enumerate(complete, start=1):
+        if not line.strip():
+            continue
+        record, problem = _parse_record(line)
+        if record is None:
+            raise ResultFolderError(
+                path, f"line {number} is not a job record of rsg sweep ({problem})", START_OVER
+            )
+        finished[record["key"]] = record
+    if last.strip():
+        record, _ = _parse_record(last)
+        if record is not None:
             finished[record["key"]] = record
+            keep = len(data)
+        else:
+            keep = len(data) - len(last)
+            print(
+                f"{path}: dropped its unfinished last line (a sweep stopped while writing "
+                "it); that job runs again",
+                file=sys.stderr,
+            )
+        try:
+            with path.open("r+b") as file:
+                file.truncate(keep)
+                if keep == len(data):
+                    file.seek(keep)
+                    file.write(b"\n")
+        except OSError as exc:
+            raise ResultFolderError(
+                path, f"cannot be repaired ({exc.strerror})", START_OVER
+            ) from exc
     return finished
+
+
+def _parse_record(line: bytes) -> tuple[dict | None, str]:
+    """(record, "") for a valid job record, else (None, what is wrong)."""
+    try:
+        record = json.loads(line.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        return None, type(exc).__name__
+    if not isinstance(record, dict):
+        return None, f"a JSON {type(record).__name__}, not an object"
+    for name, kind in RECORD_FIELDS.items():
+        value = record.get(name)
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
+            return None, f"field {name} missing or not a {getattr(kind, '__name__', 'number')}"
+    job = Job(record["controller"], math.radians(record["direction_deg"]), record["phase"])
+    if job.key != record["key"]:
+        return None, f"key {record['key'][:40]!r} does not match its fields"
+    return record, ""
 
 
 def all_jobs(spec: SweepSpec) -> list[Job]:
@@ -355,31 +468,56 @@ def all_jobs(spec: SweepSpec) -> list[Job]:
     ]
 
 
+def max_workers(backend: str = "process") -> int:
+    """The most workers a sweep or grid starts: 4 per CPU of this machine for processes
+    (more only share the CPUs and multiply the memory), :data:`MAX_RAY_WORKERS` tasks in
+    flight on a Ray cluster."""
+    return MAX_RAY_WORKERS if backend == "ray" else 4 * (os.cpu_count() or 1)
+
+
+def check_workers(workers: int, backend: str = "process") -> None:
+    """Raise a ParameterError naming ``--workers`` unless 1 <= workers <= max_workers."""
+    most = max_workers(backend)
+    if isinstance(workers, bool) or not (isinstance(workers, int) and 1 <= workers <= most):
+        raise ParameterError(
+            "--workers", workers, f"an integer in [1, {most}] ({backend} backend on this machine)"
+        )
+
+
 def run_sweep(
     spec: SweepSpec,
     out: Path,
     workers: int = 1,
     backend: str = "process",
     progress: bool = True,
+    overwrite: bool = False,
 ) -> list[dict]:
     """Run (or resume) the sweep into ``out``; returns the records of all its jobs.
 
+    Args:
+        spec, out, workers, backend, progress: What to sweep, where, how.
+        overwrite: Delete the sweep (and any other ``rsg`` results) in ``out`` first.
+
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
-        RsgError: The folder cannot be written.
+        RsgError: The folder cannot be written, or holds files that are not this
+            sweep's (:func:`app.result_folder.prepare_out`, :func:`load_finished`).
     """
-    if not (isinstance(workers, int) and 1 <= workers <= 1024):
-        raise ParameterError("--workers", workers, "an integer in [1, 1024]")
+    check_workers(workers, backend)
     if backend not in ("process", "ray"):
         raise ParameterError("--backend", backend, "process or ray")
+    own = () if overwrite else RESULT_FILES["sweep"]
+    for path in prepare_out(out, "sweep", overwrite, resumable=own):
+        if progress:
+            print(f"deleted {path} (--overwrite)", file=sys.stderr)
+    finished = load_finished(out, spec)
     try:
-        out.mkdir(parents=True, exist_ok=True)
-        finished = load_finished(out, spec)
         (out / SPEC_FILE).write_text(json.dumps(asdict(spec), indent=2) + "\n")
     except OSError as exc:
         raise RsgError(f"cannot write the sweep to {out}: {exc}") from exc
     jobs = all_jobs(spec)
     todo = [job for job in jobs if job.key not in finished]
+    workers = min(workers, max(len(todo), 1))
     bar = JobProgress(len(jobs), len(jobs) - len(todo), progress)
     with (out / JOBS_FILE).open("a") as sink:
         for record in _execute(spec, todo, workers, backend):
@@ -406,12 +544,16 @@ def run_in_processes(
     function: Callable[[T], R], arguments: list[T], workers: int
 ) -> Iterator[tuple[T, R]]:
     """(argument, result) of ``function`` for each argument, in the order they finish:
-    in this process for one worker, else in a pool (pending work is cancelled on error)."""
-    if workers == 1:
+    in this process for one worker, else in a pool of at most one worker per argument
+    whose workers end with this process (pending work is cancelled on error)."""
+    workers = min(workers, len(arguments))
+    if workers <= 1:
         for argument in arguments:
             yield argument, function(argument)
         return
-    with ProcessPoolExecutor(max_workers=workers) as pool:
+    with ProcessPoolExecutor(
+        max_workers=workers, initializer=_die_with_parent, initargs=(os.getpid(),)
+    ) as pool:
         futures = {pool.submit(function, argument): argument for argument in arguments}
         try:
             for future in as_completed(futures):
@@ -420,3 +562,30 @@ def run_in_processes(
             for future in futures:
                 future.cancel()
             raise
+
+
+PR_SET_PDEATHSIG = 1  # linux/prctl.h
+
+
+def _die_with_parent(parent: int) -> None:
+    """Worker initializer: end this worker when the process that started it ends, so a
+    sweep or grid killed by SIGKILL (which it cannot catch) leaves no orphan computing
+    for minutes. On Linux the kernel sends SIGKILL at the parent's death
+    (``prctl(PR_SET_PDEATHSIG)``, called through ctypes); everywhere, and as a backup, a
+    daemon thread checks every :data:`PARENT_POLL_PERIOD` that the parent is still the
+    parent (an orphan is re-parented)."""
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):
+            pass  # the thread below still watches
+    if os.getppid() != parent:  # the parent died before the line above
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), daemon=True).start()
+
+
+def _watch_parent(parent: int) -> None:
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_PERIOD)
+    os._exit(1)

@@ -5,14 +5,14 @@ from __future__ import annotations
 import argparse
 import os
 import time
-from pathlib import Path
 
 from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
-from .overrides import add_robot_argument, add_set_argument
+from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
+from .result_folder import add_out_arguments
 from .robot_setup import check_robot_overrides
-from .sweep import PLACO_WPG, SweepSpec, run_sweep
+from .sweep import PLACO_WPG, SweepSpec, check_workers, run_sweep
 from .sweep_plot import plot_envelope
 
 EPILOG = """\
@@ -26,7 +26,8 @@ outputs in --out:
   envelope.json, envelope.csv  largest recovered impulse and the bound per controller,
                                direction and phase
   envelope.png                 polar plot, one panel per phase
-  jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes
+  jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes (the same
+                               settings; --overwrite starts over)
 """
 
 
@@ -35,10 +36,10 @@ def _csv(text: str) -> tuple[str, ...]:
 
 
 def _phases(text: str) -> tuple[float, ...]:
-    try:
-        return tuple(float(p) for p in _csv(text))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--phases={text!r}: fractions like 0,0.25,0.5") from None
+    values = tuple(parse_decimal(p) for p in _csv(text))
+    if not values or any(v is None for v in values):
+        raise argparse.ArgumentTypeError(f"--phases={text[:60]!r}: fractions like 0,0.25,0.5")
+    return values  # type: ignore[return-value]
 
 
 def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
@@ -67,10 +68,13 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
         default=(0.0, 0.25, 0.5, 0.75),
         help="push phases, fractions of the walking cycle (default 0,0.25,0.5,0.75)",
     )
-    p.add_argument("--duration", type=float, default=0.1, help="push duration [s] (0.1)")
+    p.add_argument("--duration", type=decimal_argument("--duration"), default=0.1,
+                   help="push duration [s] (0.1)")  # fmt: skip
     p.add_argument("--cycle", type=int, default=3, help="walking cycle of the push (3)")
-    p.add_argument("--settle", type=float, default=6.0, help="time after the push [s] (6)")
-    p.add_argument("--tolerance", type=float, default=0.25, help="bisection [N s] (0.25)")
+    p.add_argument("--settle", type=decimal_argument("--settle"), default=6.0,
+                   help="time after the push [s] (6)")  # fmt: skip
+    p.add_argument("--tolerance", type=decimal_argument("--tolerance"), default=0.25,
+                   help="bisection [N s] (0.25)")  # fmt: skip
     p.add_argument("--criterion", choices=("recovered", "no-fall"), default=None,
                    help="recovered (lipm default) or no-fall (pybullet default)")  # fmt: skip
     p.add_argument(
@@ -79,10 +83,12 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
         help="the RSG without the documented extensions (push hold, leg reach in the "
         "step QP, step reaction time): the paper's jump set and QP (27) as printed",
     )
-    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
+    p.add_argument("--workers", type=int, default=None,
+                   help="parallel workers (default: the CPU count; at most 4 per CPU, and "
+                   "never more than there are jobs)")  # fmt: skip
     p.add_argument("--backend", choices=("process", "ray"), default="process",
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
-    p.add_argument("--out", type=Path, required=True, help="folder for the results")
+    add_out_arguments(p, "the results (a sweep's folder is resumed)")
     add_set_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -108,11 +114,14 @@ def sweep_command(args: argparse.Namespace) -> int:
         paper_rules=args.paper_rules,
         overrides=tuple(args.overrides),
     )
+    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    check_workers(workers, args.backend)
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
-    workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()
-    records = run_sweep(spec, args.out, workers, args.backend, progress=not args.quiet)
+    records = run_sweep(
+        spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite
+    )
     envelope = build_envelope(spec, records)
     envelope["wall_time"] = time.perf_counter() - started
     paths = write_envelope(args.out, envelope)

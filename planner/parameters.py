@@ -31,25 +31,88 @@ from .exceptions import ParameterError
 GRAVITY = 9.81  # [m/s^2]
 
 
-def _check_positive(owner: object, *names: str) -> None:
+@dataclass(frozen=True)
+class Range:
+    """The physically meaningful values of one parameter, with the unit they are in.
+
+    Attributes:
+        low: Smallest value (excluded when ``low_open``).
+        high: Largest value (included).
+        unit: Unit written after the range in messages (``"m"``, ``"s"``, ...).
+        low_open: ``low`` itself is excluded.
+    """
+
+    low: float
+    high: float
+    unit: str = ""
+    low_open: bool = False
+
+    def describe(self) -> str:
+        """``"a number in (0, 0.5] m"``."""
+        left = "(" if self.low_open else "["
+        unit = f" {self.unit}" if self.unit else ""
+        return f"a number in {left}{self.low:g}, {self.high:g}]{unit}"
+
+    def contains(self, value: object) -> bool:
+        """Whether ``value`` is a number (not a bool) within the range."""
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            return False
+        number = float(value)
+        above = number > self.low if self.low_open else number >= self.low
+        return math.isfinite(number) and above and number <= self.high
+
+    def check(self, name: str, value: object) -> None:
+        """Raise a ParameterError naming ``name`` unless ``value`` is in the range."""
+        if not self.contains(value):
+            raise ParameterError(name, value, self.describe())
+
+
+#: Every number of the planner's parameters, with the range in which it means something
+#: physically (a robot from a few kg to an adult humanoid walking on Earth-like gravity).
+#: Checked where each dataclass is built; the robot descriptions use the same table.
+RANGES: dict[str, Range] = {
+    # LipmModel
+    "mass": Range(0.0, 1000.0, "kg", low_open=True),
+    "com_height": Range(0.05, 5.0, "m"),
+    "gravity": Range(0.0, 100.0, "m/s^2", low_open=True),
+    # GaitParameters: a step of at most 1 m, phases from one G1 tick to a slow walk
+    "stride_length": Range(-1.0, 1.0, "m"),
+    "step_width": Range(0.0, 1.0, "m", low_open=True),
+    "double_support_duration": Range(0.01, 2.0, "s"),
+    "single_support_duration": Range(0.05, 5.0, "s"),
+    # Constraints
+    "angular_momentum_rate_max": Range(0.0, 10000.0, "N m", low_open=True),
+    "com_reach": Range(0.0, 5.0, "m", low_open=True),
+    # RsgParameters
+    "filter_time_constant": Range(0.001, 1.0, "s"),
+    "lyapunov_threshold": Range(1e-6, 1.0),
+    "step_decrease_margin": Range(0.0, 1.0, low_open=True),
+    "crossing_margin": Range(0.0, 0.5, "m", low_open=True),
+    "com_margin": Range(0.0, 0.2, "m", low_open=True),
+    "swing_preparation_time": Range(0.0, 2.0, "s", low_open=True),
+    "lqr_dcm_error_scale": Range(1e-4, 1.0, "m"),
+    "lqr_zmp_scale": Range(1e-4, 1.0, "m"),
+    "lqr_angular_momentum_scale": Range(1e-3, 10000.0, "N m"),
+    "step_reaction_time": Range(0.0, 1.0, "s"),
+    "push_hold_time": Range(0.0, 1.0, "s"),
+    "push_cmp_threshold": Range(0.0, 1.0, "m", low_open=True),
+    "reanchor_time": Range(0.0, 1.0, "s"),
+    "dcm_inset": Range(-0.1, 0.1, "m"),
+}
+#: Bound on each coordinate of the ZMP window and of the step bounds [m].
+CORNER_RANGE = Range(-2.0, 2.0, "m")
+
+
+def _check_ranges(owner: object, *names: str) -> None:
     for name in names:
-        value = getattr(owner, name)
-        if not (isinstance(value, int | float) and math.isfinite(value) and value > 0.0):
-            raise ParameterError(name, value, "a finite number > 0")
+        RANGES[name].check(name, getattr(owner, name))
 
 
-def _check_range(name: str, value: float, low: float, high: float) -> None:
-    if not (math.isfinite(value) and low <= value <= high):
-        raise ParameterError(name, value, f"a number in [{low}, {high}]")
-
-
-def _check_finite(owner: object) -> None:
-    for f in fields(owner):  # type: ignore[arg-type]
-        value = getattr(owner, f.name)
-        if isinstance(value, bool):
-            continue
-        if isinstance(value, int | float) and not math.isfinite(value):
-            raise ParameterError(f.name, value, "a finite number")
+def _check_pair(name: str, value: object) -> None:
+    """Two finite numbers (x, y), each within :data:`CORNER_RANGE` [m]."""
+    pair: tuple = tuple(value) if isinstance(value, tuple | list | np.ndarray) else ()
+    if len(pair) != 2 or not all(CORNER_RANGE.contains(v) for v in pair):
+        raise ParameterError(name, value, "two numbers (x, y), each in [-2, 2] m")
 
 
 @dataclass(frozen=True)
@@ -67,8 +130,7 @@ class LipmModel:
     gravity: float = GRAVITY
 
     def __post_init__(self) -> None:
-        _check_positive(self, "mass", "com_height", "gravity")
-        _check_range("com_height", self.com_height, 0.05, 5.0)
+        _check_ranges(self, "mass", "com_height", "gravity")
 
     @property
     def omega(self) -> float:
@@ -93,9 +155,13 @@ class GaitParameters:
     single_support_duration: float = 0.7
 
     def __post_init__(self) -> None:
-        _check_finite(self)
-        _check_range("stride_length", self.stride_length, -1.0, 1.0)
-        _check_positive(self, "step_width", "double_support_duration", "single_support_duration")
+        _check_ranges(
+            self,
+            "stride_length",
+            "step_width",
+            "double_support_duration",
+            "single_support_duration",
+        )
 
     @property
     def step_duration(self) -> float:
@@ -129,12 +195,10 @@ class Constraints:
     com_reach: float = 0.58
 
     def __post_init__(self) -> None:
-        if not (self.com_reach > 0.0):
-            raise ParameterError("com_reach", self.com_reach, "a number > 0 (inf: off)")
+        if self.com_reach != math.inf and not RANGES["com_reach"].contains(self.com_reach):
+            raise ParameterError("com_reach", self.com_reach, "a number in (0, 5] m, or inf: off")
         for name in ("zmp_window_min", "zmp_window_max", "step_min", "step_max"):
-            value = getattr(self, name)
-            if len(value) != 2 or not all(math.isfinite(v) for v in value):
-                raise ParameterError(name, value, "two finite numbers (x, y) [m]")
+            _check_pair(name, getattr(self, name))
         lo, hi = self.zmp_window_min, self.zmp_window_max
         if not (lo[0] < 0.0 < hi[0]):
             raise ParameterError("zmp_window_min/zmp_window_max x", (lo[0], hi[0]), "min < 0 < max")
@@ -142,7 +206,7 @@ class Constraints:
             raise ParameterError(
                 "zmp_window_min/zmp_window_max y", (lo[1], hi[1]), "symmetric: min = -max < 0"
             )
-        _check_positive(self, "angular_momentum_rate_max")
+        _check_ranges(self, "angular_momentum_rate_max")
         if not (self.step_min[0] < 0.0 < self.step_max[0]):
             raise ParameterError(
                 "step_min/step_max x", (self.step_min[0], self.step_max[0]), "min < 0 < max"
@@ -216,23 +280,8 @@ class RsgParameters:
 
     def __post_init__(self) -> None:
         if self.dcm_inset is not None:
-            _check_range("dcm_inset", self.dcm_inset, -0.1, 0.1)
-        _check_range("step_reaction_time", self.step_reaction_time, 0.0, 1.0)
-        _check_range("push_hold_time", self.push_hold_time, 0.0, 1.0)
-        _check_range("reanchor_time", self.reanchor_time, 0.0, 1.0)
-        _check_positive(
-            self,
-            "filter_time_constant",
-            "lyapunov_threshold",
-            "step_decrease_margin",
-            "crossing_margin",
-            "com_margin",
-            "swing_preparation_time",
-            "lqr_dcm_error_scale",
-            "lqr_zmp_scale",
-            "lqr_angular_momentum_scale",
-            "push_cmp_threshold",
-        )
+            _check_ranges(self, "dcm_inset")
+        _check_ranges(self, *(f.name for f in fields(self) if f.name != "dcm_inset"))
 
 
 CONTROLLERS = ("rsg", "fixed-timing", "no-step")
@@ -267,19 +316,20 @@ class PlannerConfig:
             raise ParameterError(
                 "step_width",
                 self.gait.step_width,
-                f">= 2 w_y + mu_2 = {min_width:.3f} m so the nominal gait meets (27b)",
+                f">= 2 w_y + crossing_margin = {min_width:.3f} m (w_y = {w_y:g} m, half the "
+                "ZMP window) so the nominal gait meets (27b)",
             )
         if self.constraints.step_max[1] < min_width:
             raise ParameterError(
                 "step_max y",
                 self.constraints.step_max[1],
-                f">= 2 w_y + mu_2 = {min_width:.3f} m so the QP (27) can be feasible",
+                f">= 2 w_y + crossing_margin = {min_width:.3f} m so the QP (27) can be feasible",
             )
         if self.gait.step_width > self.constraints.step_max[1]:
             raise ParameterError(
                 "step_width",
                 self.gait.step_width,
-                f"<= step_max y = {self.constraints.step_max[1]} m",
+                f"<= step_max y = {self.constraints.step_max[1]:g} m",
             )
         if not (
             self.constraints.step_min[0] <= self.gait.stride_length <= self.constraints.step_max[0]
@@ -287,8 +337,21 @@ class PlannerConfig:
             raise ParameterError(
                 "stride_length",
                 self.gait.stride_length,
-                f"within the step bounds [{self.constraints.step_min[0]}, "
-                f"{self.constraints.step_max[0]}] m",
+                f"within the step bounds step_min x, step_max x = [{self.constraints.step_min[0]:g}"
+                f", {self.constraints.step_max[0]:g}] m",
+            )
+        if self.rsg.com_margin >= w_y:
+            raise ParameterError(
+                "com_margin",
+                self.rsg.com_margin,
+                f"< w_y = {w_y:g} m (half the ZMP window) so (27c) leaves room for a step",
+            )
+        if self.rsg.swing_preparation_time > self.gait.single_support_duration:
+            raise ParameterError(
+                "swing_preparation_time",
+                self.rsg.swing_preparation_time,
+                f"<= single_support_duration = {self.gait.single_support_duration:g} s (the "
+                "swing foot must be ready by the nominal step)",
             )
 
     @property

@@ -16,6 +16,22 @@ from types import MappingProxyType
 from typing import Any
 
 from planner.exceptions import ParameterError
+from planner.parameters import CORNER_RANGE, RANGES
+
+#: Fields handed to the planner (app.robot_setup.planner_config_for), checked with the
+#: planner's ranges so that an error names the description field.
+PLANNER_FIELDS = (
+    "stride_length",
+    "step_width",
+    "double_support_duration",
+    "single_support_duration",
+    "angular_momentum_rate_max",
+    "lqr_dcm_error_scale",
+    "swing_preparation_time",
+    "filter_time_constant",
+    "step_reaction_time",
+    "reanchor_time",
+)
 
 
 @dataclass(frozen=True)
@@ -203,8 +219,8 @@ class RobotDescription:
             raise ParameterError("fall_tilt", self.fall_tilt, "0 < tilt < pi/2 rad")
         if not 0.0 < self.swing_height < 0.3:
             raise ParameterError("swing_height", self.swing_height, "0 < h < 0.3 m")
-        if not self.ground_friction > 0.0:
-            raise ParameterError("ground_friction", self.ground_friction, "> 0")
+        if not 0.0 < self.ground_friction <= 10.0:
+            raise ParameterError("ground_friction", self.ground_friction, "a number in (0, 10]")
         if not 0.0 <= self.sole_spinning_friction <= 0.1:
             raise ParameterError(
                 "sole_spinning_friction", self.sole_spinning_friction, "in [0, 0.1] m"
@@ -218,10 +234,14 @@ class RobotDescription:
         for joint, angle in self.standing_posture.items():
             if not math.isfinite(angle):
                 raise ParameterError(f"standing_posture[{joint}]", angle, "a finite angle [rad]")
-        if self.dcm_inset is not None and not (
-            math.isfinite(self.dcm_inset) and -0.1 <= self.dcm_inset <= 0.1
-        ):
-            raise ParameterError("dcm_inset", self.dcm_inset, "None or in [-0.1, 0.1] m")
+        for name in PLANNER_FIELDS:
+            RANGES[name].check(name, getattr(self, name))
+        for name in ("step_min", "step_max"):
+            pair = getattr(self, name)
+            if len(pair) != 2 or not all(CORNER_RANGE.contains(v) for v in pair):
+                raise ParameterError(name, pair, "two numbers (x, y), each in [-2, 2] m")
+        if self.dcm_inset is not None and not RANGES["dcm_inset"].contains(self.dcm_inset):
+            raise ParameterError("dcm_inset", self.dcm_inset, "none or a number in [-0.1, 0.1] m")
         locked = tuple(self.locked_joints)
         named = all(isinstance(name, str) and name for name in locked)
         if not named or len(set(locked)) != len(locked):

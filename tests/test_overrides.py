@@ -76,7 +76,8 @@ def test_each_name_goes_where_it_applies() -> None:
     ("overrides", "model", "field"),
     [
         ((("no_such_parameter", "1"),), "pybullet", "--set"),
-        ((("cop_admittance", "0.2"),), "lipm", "--set"),
+        ((("cop_admittance", "0.2"),), "lipm", "--set cop_admittance"),  # PyBullet only
+        ((("step_width", "0.3"),), "lipm", "--set"),  # the paper's LIPM: RSG parameters
         ((("crossing_margin", "0.03"), ("crossing_margin", "0.04")), "lipm",
          "--set crossing_margin"),
         ((("cop_feedback", "1,2,3"),), "pybullet", "--set cop_feedback"),
@@ -158,7 +159,7 @@ def test_a_bad_override_is_a_clear_error_before_any_run(tmp_path: Path, capsys) 
     code = main(["grid", "--model", "lipm", "--set", "cop_admittance=0.2", "--out", str(tmp_path)])
     assert code == 2
     err = capsys.readouterr().err
-    assert "--set" in err and "cop_admittance" in err and "RSG parameters only" in err
+    assert "--set cop_admittance" in err and "only with --model pybullet" in err
     assert not (tmp_path / "grid.json").exists()
     with pytest.raises(ParameterError):
         GridSpec(overrides=(("swing_preparation_time", "soon"),))
@@ -179,19 +180,26 @@ def test_a_resumed_sweep_must_have_the_same_overrides(tmp_path: Path) -> None:
     assert "0.05" in error.value.allowed  # what the folder holds
 
 
-def test_an_error_in_a_worker_process_reaches_the_command_with_its_data(tmp_path: Path, capsys):
-    """An RSG parameter out of range is found when each worker builds its planner; the
-    error crosses the process boundary intact (exit 2, the broken rule named: the
-    nominal step width must exceed 2 w_y + mu_2, here 0.14 + 5 m)."""
-    code = main(
-        ["grid", "--model", "lipm", "--controllers", "rsg", "--impulses", "20",
-         "--directions", "2", "--workers", "2", "--set", "crossing_margin=5",
-         "--out", str(tmp_path)]
-    )  # fmt: skip
-    assert code == 2
-    err = capsys.readouterr().err
-    assert "step_width=0.2 is not allowed" in err and "2 w_y + mu_2 = 5.140 m" in err
-    assert "Traceback" not in err
+def test_a_bad_override_is_caught_before_any_worker_or_folder(tmp_path: Path, capsys):
+    """An RSG parameter out of its range, or breaking a rule between parameters, is
+    found before the workers start and before --out is made (exit 2, the --set named
+    with its value and what is allowed: mu_2 in (0, 0.5] m; with mu_2 = 0.3 the nominal
+    step width 0.2 m is below 2 w_y + mu_2 = 0.14 + 0.3 m)."""
+    for value, expected in [
+        ("5", "--set crossing_margin='5' is not allowed: expected a number in (0, 0.5] m"),
+        ("0.3", "step_width=0.2 to be >= 2 w_y + crossing_margin = 0.440 m"),
+    ]:
+        out = tmp_path / value
+        code = main(
+            ["grid", "--model", "lipm", "--controllers", "rsg", "--impulses", "20",
+             "--directions", "2", "--workers", "2", "--set", f"crossing_margin={value}",
+             "--out", str(out)]
+        )  # fmt: skip
+        assert code == 2
+        err = capsys.readouterr().err
+        assert expected in err and "--set crossing_margin" in err
+        assert "Traceback" not in err
+        assert not out.exists()
 
 
 def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
@@ -212,6 +220,10 @@ def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
     assert paper.model.mass != pytest.approx(g1.total_mass)
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("cop_admittance", "0.2"),))
+    assert error.value.field == "--set cop_admittance"
+    assert "only with --model pybullet" in error.value.allowed
+    with pytest.raises(ParameterError) as error:
+        build_backend("lipm", "g1", "rsg", overrides=(("no_such_name", "0.2"),))
     assert "swing_preparation_time" in error.value.allowed
     assert "cop_admittance" not in error.value.allowed
     assert "swing_preparation_time" in allowed_names("lipm", "g1")
@@ -252,7 +264,8 @@ def test_the_reanchor_time_of_a_robot_reaches_its_planner() -> None:
     assert config.rsg.reanchor_time == 0.05
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("reanchor_time", "2"),))
-    assert error.value.field == "reanchor_time"
+    assert error.value.field == "--set reanchor_time"
+    assert error.value.allowed == "a number in [0, 1] s"
 
 
 def test_the_solver_iterations_reach_pybullet() -> None:
@@ -305,8 +318,9 @@ def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
             backend.close()
     with pytest.raises(ParameterError) as error:
         build_robot_backend("g1", "rsg", overrides=(("physics_time_step", "0.003"),))
-    assert error.value.field == "control_period/physics_time_step"
-    assert error.value.value == (0.01, 0.003)
+    assert error.value.field == "--set physics_time_step"
+    assert error.value.value == "0.003"
+    assert "control_period/physics_time_step=(0.01, 0.003)" in error.value.allowed
     with pytest.raises(ParameterError) as error:
         robot_with_overrides("g1", (("physics_time_step", "0.01"),), "pybullet")
     assert error.value.field == "physics_time_step"
@@ -320,7 +334,7 @@ def test_the_dcm_inset_of_a_robot_reaches_its_planner() -> None:
     assert config.rsg.dcm_inset is None
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("dcm_inset", "0.5"),))
-    assert error.value.field == "dcm_inset"
+    assert error.value.field == "--set dcm_inset"
 
 
 def test_locked_joints_are_welded_in_pybullet_and_set_unlocks_them() -> None:
