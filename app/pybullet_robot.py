@@ -19,8 +19,12 @@ import pybullet_data
 from numpy.typing import NDArray
 from pybullet_utils.bullet_client import BulletClient
 
+from kinematics.robot_model import RobotModel
 from robots.description import RobotDescription
 from robots.urdf_cache import derived_urdf
+
+from .joint_motors import JointMotors
+from .lowlevel import FootForce, JointCommand, RobotMeasurement
 
 GRAVITY = 9.81  # [m/s^2]
 
@@ -37,7 +41,7 @@ class SimulatedRobot:
         time: Simulated time [s].
     """
 
-    def __init__(self, description: RobotDescription) -> None:
+    def __init__(self, description: RobotDescription, torque_control: bool = False) -> None:
         self.description = description
         self.time_step = description.physics_time_step
         self.client = BulletClient(connection_mode=pybullet.DIRECT)
@@ -96,6 +100,13 @@ class SimulatedRobot:
         self._step_simulation = pybullet.stepSimulation
         self._contacts: tuple | None = None  # contact points of the current state
         self.time = 0.0
+        self.motors: JointMotors | None = None
+        if torque_control:
+            model = RobotModel(description)
+            if model.joint_names != self.joint_names:
+                raise ValueError(f"joint order differs: {model.joint_names} / {self.joint_names}")
+            self.motors = JointMotors(model, self.time_step)
+            self._motor_target = np.zeros(len(self.joint_names))
 
     # ----------------------------------------------------------------- state
     def set_configuration(
@@ -254,6 +265,87 @@ class SimulatedRobot:
             forces=self._max_forces,
             physicsClientId=self._client_id,
         )
+
+    # ------------------------------------------------------- torque control
+    def measure(self) -> RobotMeasurement:
+        """Encoders, IMU, foot forces and the base's true pose and velocity."""
+        states = self.client.getJointStates(self.body, self.joint_indices)
+        position, quaternion = self.base_pose()
+        inertial_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        linear, angular = self.client.getBaseVelocity(self.body)
+        rotation = np.array(self.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+        # PyBullet's base velocity is that of the inertial frame origin.
+        origin_velocity = np.array(linear) + np.cross(angular, position - np.array(inertial_position))
+        forces = {
+            foot: FootForce(force, cop) for foot, (cop, force) in self.foot_pressure().items()
+        }
+        return RobotMeasurement(
+            time=self.time,
+            joint_positions=np.array([s[0] for s in states]),
+            joint_velocities=np.array([s[1] for s in states]),
+            base_orientation=np.asarray(quaternion, float),
+            base_angular_velocity=rotation.T @ np.asarray(angular, float),
+            foot_forces=forces,
+            base_position=np.asarray(position, float),
+            base_linear_velocity=origin_velocity,
+        )
+
+    def set_motor_target(self, angles: NDArray[np.float64]) -> None:
+        """Where the next tick's target angles start from [rad] (after a reset)."""
+        self._motor_target = np.asarray(angles, float).copy()
+
+    def actuate(
+        self,
+        command: JointCommand,
+        measurement: RobotMeasurement,
+        steps: int,
+        expected_contact_force: NDArray[np.float64],
+        base_force_world: NDArray[np.float64] | None = None,
+    ) -> None:
+        """Run ``steps`` physics steps with the motors on ``command`` (torque control).
+
+        ``measurement`` is the state at the start of the tick (the motors' model
+        uses its true base state); ``expected_contact_force`` is J^T f of the contact
+        forces expected over the tick (:mod:`app.joint_motors`). ``base_force_world``
+        [N] pushes the pelvis.
+        """
+        motors = self.motors
+        if motors is None:
+            raise ValueError("actuate() needs a robot built with torque_control=True")
+        model = motors.model
+        q = np.concatenate(
+            [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
+        )
+        rotation = np.array(
+            self.client.getMatrixFromQuaternion(measurement.base_orientation)
+        ).reshape(3, 3)
+        v = np.concatenate(
+            [
+                rotation.T @ measurement.base_linear_velocity,
+                measurement.base_angular_velocity,
+                measurement.joint_velocities,
+            ]
+        )
+        model.update(q, v)
+        motors.prepare(command, self._motor_target, expected_contact_force)
+        self._motor_target = command.position.copy()
+        for step in range(1, steps + 1):
+            states = pybullet.getJointStates(
+                self.body, self.joint_indices, physicsClientId=self._client_id
+            )
+            torques = motors.torques(
+                step / steps,
+                np.array([s[0] for s in states]),
+                np.array([s[1] for s in states]),
+            )
+            self._set_motors(
+                self.body,
+                self.joint_indices,
+                pybullet.TORQUE_CONTROL,
+                forces=torques.tolist(),
+                physicsClientId=self._client_id,
+            )
+            self.step(base_force_world)
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step (``time_step`` [s]) with a force [N] on the base CoM.
