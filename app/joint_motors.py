@@ -100,4 +100,4 @@ class JointMotors:
         pd = self._stiffness * (error - dt * velocity) + self._damping * velocity_error
         acceleration = self._inverse @ (pd + self._bias)
         torque = pd[6:] - command.damping * dt * acceleration[6:] + command.torque
-        return np.clip(torque, -self.effort_limits, self.effort_limits)
+        return np.minimum(np.maximum(torque, -self.effort_limits), self.effort_limits)

@@ -111,7 +111,7 @@ class WholeBodyBackend:
         self.timers.clear()
         self.ticks = 0
         measurement = self.sim.measure()
-        controller.estimator.update(measurement, stance)
+        self._measurement = measurement
         controller.state = controller.estimator.update(measurement, stance)
         controller._stance_sole_report = None
         controller._report_touchdown = None
@@ -120,7 +120,7 @@ class WholeBodyBackend:
 
     def step(self, command: PlannerOutput, push_force: Vector2) -> MeasuredState:
         start = clock.perf_counter()
-        measurement = self.sim.measure()
+        measurement = self._measurement
         joint_command = self.controller.tick(measurement, command)
         controlled = clock.perf_counter()
         force = np.array([push_force[0], push_force[1], 0.0]) if any(push_force) else None
@@ -128,9 +128,8 @@ class WholeBodyBackend:
             joint_command, measurement, self._substeps, self.controller.expected_contact_force, force
         )
         stepped = clock.perf_counter()
-        measurement = self.sim.measure()
-        self.controller.state = self.controller.estimator.update(measurement, command.stance.foot)
-        self._measured = self.controller.planner_state()
+        self._measurement = self.sim.measure()
+        self._measured = self.controller.observe(self._measurement, command.stance.foot)
         self.timers["control"] += controlled - start
         self.timers["physics"] += stepped - controlled
         self.ticks += 1

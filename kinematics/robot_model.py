@@ -120,7 +120,14 @@ class RobotModel:
         )
         origin = self.data.oMf[frame].translation
         force = wrench[:3]
-        moment = wrench[3:] + np.cross(point - origin, force)
+        arm = point - origin
+        moment = wrench[3:] + np.array(
+            [
+                arm[1] * force[2] - arm[2] * force[1],
+                arm[2] * force[0] - arm[0] * force[2],
+                arm[0] * force[1] - arm[1] * force[0],
+            ]
+        )
         return jacobian.T @ np.concatenate([force, moment])
 
     def foot_jacobian(self, foot: str) -> NDArray[np.float64]:

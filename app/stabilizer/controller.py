@@ -55,6 +55,7 @@ class ControllerOptions:
     verbose: bool = False
     stance_from_measured: bool = False
     landing_depth: float = 0.0
+    load_rate: float = 0.0
     landing_window: float = 0.1
 
 
@@ -122,6 +123,7 @@ class WholeBodyController:
         self.ik_failure: str | None = None
         self.planned_cop = np.zeros(2)
         self._report_touchdown: NDArray[np.float64] | None = None
+        self._normal_forces: dict[str, float] = {}
 
     # ------------------------------------------------------------------ reset
     def reset(self, stance_sole: NDArray, swing_sole: NDArray, stance: Foot, com_xy: NDArray) -> NDArray:
@@ -146,9 +148,11 @@ class WholeBodyController:
         o = self.options
         stance: Foot = command.stance.foot
         swing_foot = other_foot(stance)
-        # measure
-        state = self.estimator.update(measurement, stance)
-        self.state, self.measurement = state, measurement
+        # measure (the estimate of this measurement was made by observe())
+        if self.state is None or self.state.time != measurement.time:
+            self.observe(measurement, stance)
+        state = self.state
+        self.measurement = measurement
         model = self.model
         if stance != self._stance:
             self.swing.start(model.sole_frame(swing_foot)[0][:2])
@@ -183,8 +187,12 @@ class WholeBodyController:
             ramp = float(np.clip(1.0 - lead / o.landing_window, 0.0, 1.0))
             swing_position = swing_position.copy()
             swing_position[2] -= o.landing_depth * ramp
+        settle = 0.0
+        if o.landing_depth > 0.0 and command.double_support:
+            # The new stance sole comes up from the landing depth over the double support.
+            settle = -o.landing_depth * max(0.0, 1.0 - time_since_step / self.timing.double_support)
         soles = {
-            stance: sole_pose(np.array([stance_position[0], stance_position[1], 0.0]), self._stance_yaw),
+            stance: sole_pose(np.array([stance_position[0], stance_position[1], settle]), self._stance_yaw),
             swing_foot: sole_pose(swing_position),
         }
         # IK
@@ -215,16 +223,21 @@ class WholeBodyController:
         # landing keeps the weight on the old foot); in the air, the stance foot.
         feet = [f for f in planned if f in touching] or touching or [stance]
         contacts = []
+        change = o.load_rate * self.mass * GRAVITY * dt  # [N] per tick
         for foot in feet:
             position, rotation = model.sole_frame(foot)
+            previous_force = self._normal_forces.get(foot, 0.0)
+            bounds = (max(previous_force - change, 0.0), previous_force + change) if o.load_rate > 0 and len(feet) > 1 else (0.0, np.inf)
             contacts.append(
                 FootContact(
                     np.array([position[0], position[1], 0.0]),
                     float(np.arctan2(rotation[1, 0], rotation[0, 0])),
                     self.ankle_height,
+                    *bounds,
                 )
             )
         wrenches = distribute_wrench(contacts, force, cop, self.limits)
+        self._normal_forces = {foot: float(w[2]) for foot, w in zip(feet, wrenches, strict=True)}
         # inverse dynamics feed-forward
         acceleration = np.zeros(model.nv)
         acceleration[6:] = self._acceleration
@@ -249,6 +262,11 @@ class WholeBodyController:
             forces = ",".join(f"{k[0]}{v.normal_force:.0f}" for k, v in measurement.foot_forces.items())
             print(f"{measurement.time:.2f} {'DS' if command.double_support else 'SS'} {stance[0]} feet={''.join(f[0] for f in feet)} cop=({cop[0]:.3f},{cop[1]:.3f}) fz={forces} e=({command.dcm_error[0]*100:+.1f},{command.dcm_error[1]*100:+.1f}) sw={np.round(model.sole_frame(swing_foot)[0],3)} swt={np.round(swing_position,3)}")
         return JointCommand(q_ik, velocity, self.stiffness, self.damping, torque[6:])
+
+    def observe(self, measurement: RobotMeasurement, stance: Foot) -> MeasuredState:
+        """Estimate the state from ``measurement``; return what the planner reads."""
+        self.state = self.estimator.update(measurement, stance)
+        return self.planner_state()
 
     def planner_state(self) -> MeasuredState:
         """What the RSG reads: CoM, its velocity, the stance sole, a touchdown."""

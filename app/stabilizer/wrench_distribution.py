@@ -40,13 +40,14 @@ class FootContact:
         sole_point: Ground point under the ankle [m], shape (3,).
         yaw: Heading of the sole about the vertical [rad].
         ankle_height: Height of the ankle above the sole [m].
-        max_force: Upper bound on the foot's normal force [N] (a foot that is
-            touching down but not yet loaded is capped low).
+        min_force: Lower bound on the foot's normal force [N] (a foot being unloaded).
+        max_force: Upper bound on the foot's normal force [N] (a foot being loaded).
     """
 
     sole_point: NDArray[np.float64]
     yaw: float
     ankle_height: float
+    min_force: float = 0.0
     max_force: float = np.inf
 
 
@@ -116,7 +117,7 @@ def _cone(limits: ContactLimits, contact: FootContact) -> tuple[NDArray, NDArray
     ]
     G = np.array([np.concatenate([f @ rotation.T, m @ rotation.T]) for f, m in rows_local])
     h = np.zeros(len(rows_local))
-    bounds = [(np.array([0, 0, -1.0, 0, 0, 0]), -limits.min_force)]
+    bounds = [(np.array([0, 0, -1.0, 0, 0, 0]), -max(limits.min_force, contact.min_force))]
     if np.isfinite(contact.max_force):
         bounds.append((np.array([0, 0, 1.0, 0, 0, 0]), contact.max_force))
     G = np.vstack([G, *[row for row, _ in bounds]])
@@ -179,7 +180,7 @@ def _single_support(
     """The QP's solution for one foot in closed form: the force within the friction
     pyramid, the CoP clipped to the sole, no torsion."""
     rotation = _yaw_matrix(contact.yaw)
-    normal = float(np.clip(force[2], limits.min_force, contact.max_force))
+    normal = float(np.clip(force[2], max(limits.min_force, contact.min_force), contact.max_force))
     local_force = rotation.T @ force
     bound = limits.friction * normal
     local_force = np.array([*np.clip(local_force[:2], -bound, bound), normal])
