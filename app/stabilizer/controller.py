@@ -56,6 +56,7 @@ class ControllerOptions:
     stance_from_measured: bool = False
     landing_depth: float = 0.0
     load_rate: float = 0.0
+    press_time: float = 0.02
     landing_window: float = 0.1
 
 
@@ -181,7 +182,7 @@ class WholeBodyController:
             time_since_step, np.asarray(command.next_step.position, float), dt, landing
         )
         stance_position = model.sole_frame(stance)[0] if o.stance_from_measured else np.array([*command.stance.position, 0.0])
-        if o.landing_depth > 0.0 and not command.double_support:
+        if o.landing_depth > 0.0 and not command.double_support and o.landing_window > 0.0:
             # Aim below the ground at the landing time: contact comes by then, not after.
             lead = landing - time_since_step
             ramp = float(np.clip(1.0 - lead / o.landing_window, 0.0, 1.0))
@@ -189,8 +190,14 @@ class WholeBodyController:
             swing_position[2] -= o.landing_depth * ramp
         settle = 0.0
         if o.landing_depth > 0.0 and command.double_support:
-            # The new stance sole comes up from the landing depth over the double support.
-            settle = -o.landing_depth * max(0.0, 1.0 - time_since_step / self.timing.double_support)
+            if o.landing_window > 0.0:
+                # The new stance sole comes up from the landing depth over the double support.
+                settle = -o.landing_depth * max(0.0, 1.0 - time_since_step / self.timing.double_support)
+            else:
+                # The new stance sole is pressed down, then comes back, over the double support.
+                rise = min(time_since_step / o.press_time, 1.0)
+                fall = max(0.0, 1.0 - (time_since_step - o.press_time) / (self.timing.double_support - o.press_time))
+                settle = -o.landing_depth * min(rise, fall)
         soles = {
             stance: sole_pose(np.array([stance_position[0], stance_position[1], settle]), self._stance_yaw),
             swing_foot: sole_pose(swing_position),
