@@ -57,6 +57,7 @@ class ControllerOptions:
     landing_depth: float = 0.0
     load_rate: float = 0.0
     press_time: float = 0.02
+    touchdown_speed: float = 0.0
     landing_window: float = 0.1
 
 
@@ -94,6 +95,7 @@ class WholeBodyController:
             timing,
             apex_height=description.swing_height,
             arrival_lead=0.1,
+            touchdown_speed=self.options.touchdown_speed,
             max_acceleration=20.0,
             descent_slope=0.5,
             land_on_time=True,
