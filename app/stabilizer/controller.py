@@ -58,6 +58,10 @@ class ControllerOptions:
     load_rate: float = 0.0
     press_time: float = 0.02
     touchdown_speed: float = 0.0
+    landing_admittance: float = 0.0
+    touch_force: float = 0.05
+    yield_time: float = 0.05
+    settle_from_swing: bool = False
     landing_window: float = 0.1
 
 
@@ -127,6 +131,8 @@ class WholeBodyController:
         self.planned_cop = np.zeros(2)
         self._report_touchdown: NDArray[np.float64] | None = None
         self._normal_forces: dict[str, float] = {}
+        self._yield = 0.0
+        self._last_swing_height = 0.0
 
     # ------------------------------------------------------------------ reset
     def reset(self, stance_sole: NDArray, swing_sole: NDArray, stance: Foot, com_xy: NDArray) -> NDArray:
@@ -158,6 +164,7 @@ class WholeBodyController:
         self.measurement = measurement
         model = self.model
         if stance != self._stance:
+            self._yield = 0.0
             self.swing.start(model.sole_frame(swing_foot)[0][:2])
             _, rotation = model.sole_frame(stance)
             self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
@@ -190,8 +197,20 @@ class WholeBodyController:
             ramp = float(np.clip(1.0 - lead / o.landing_window, 0.0, 1.0))
             swing_position = swing_position.copy()
             swing_position[2] -= o.landing_depth * ramp
+        if o.landing_admittance > 0.0 and not command.double_support:
+            # Landing compliance: a touching swing sole yields to what it carries above
+            # the touch force, and comes back down when unloaded.
+            excess = measurement.normal_force(swing_foot) - o.touch_force * self.mass * GRAVITY
+            self._yield += dt * (o.landing_admittance * excess - self._yield / o.yield_time)
+            self._yield = min(max(self._yield, 0.0), o.landing_depth + 0.02)
+            swing_position = swing_position.copy()
+            swing_position[2] += self._yield
+        if not command.double_support:
+            self._last_swing_height = float(swing_position[2])
         settle = 0.0
-        if o.landing_depth > 0.0 and command.double_support:
+        if o.settle_from_swing and command.double_support:
+            settle = self._last_swing_height * max(0.0, 1.0 - time_since_step / self.timing.double_support)
+        elif o.landing_depth > 0.0 and command.double_support:
             if o.landing_window > 0.0:
                 # The new stance sole comes up from the landing depth over the double support.
                 settle = -o.landing_depth * max(0.0, 1.0 - time_since_step / self.timing.double_support)
