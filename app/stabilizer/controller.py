@@ -62,6 +62,8 @@ class ControllerOptions:
     touch_force: float = 0.05
     yield_time: float = 0.05
     settle_from_swing: bool = False
+    compensate_touch: bool = False
+    settle: bool = True
     landing_window: float = 0.1
 
 
@@ -210,7 +212,7 @@ class WholeBodyController:
         settle = 0.0
         if o.settle_from_swing and command.double_support:
             settle = self._last_swing_height * max(0.0, 1.0 - time_since_step / self.timing.double_support)
-        elif o.landing_depth > 0.0 and command.double_support:
+        elif o.landing_depth > 0.0 and command.double_support and o.settle:
             if o.landing_window > 0.0:
                 # The new stance sole comes up from the landing depth over the double support.
                 settle = -o.landing_depth * max(0.0, 1.0 - time_since_step / self.timing.double_support)
@@ -264,6 +266,14 @@ class WholeBodyController:
                     *bounds,
                 )
             )
+        if o.compensate_touch and not command.double_support and swing_foot not in feet:
+            reading = measurement.foot_forces.get(swing_foot)
+            if reading is not None and reading.normal_force > 1.0:
+                # A touching swing sole is not a planned support: its measured force is
+                # known, and the stance foot realises the rest about the desired CoP.
+                share = min(reading.normal_force, 0.9 * force[2])
+                cop = (cop * force[2] - reading.cop * share) / (force[2] - share)
+                force = force - np.array([0.0, 0.0, share])
         wrenches = distribute_wrench(contacts, force, cop, self.limits)
         self._normal_forces = {foot: float(w[2]) for foot, w in zip(feet, wrenches, strict=True)}
         # inverse dynamics feed-forward
