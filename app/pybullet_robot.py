@@ -103,8 +103,9 @@ class SimulatedRobot:
         self.motors: JointMotors | None = None
         if torque_control:
             model = RobotModel(description)
-            if model.joint_names != self.joint_names:
-                raise ValueError(f"joint order differs: {model.joint_names} / {self.joint_names}")
+            # The low-level interface orders joints as the rigid-body model does.
+            self._model_order = [self.joint_names.index(name) for name in model.joint_names]
+            self._model_indices = [self.joint_indices[i] for i in self._model_order]
             self.motors = JointMotors(model, self.time_step)
             self._motor_target = np.zeros(len(self.joint_names))
 
@@ -268,8 +269,9 @@ class SimulatedRobot:
 
     # ------------------------------------------------------- torque control
     def measure(self) -> RobotMeasurement:
-        """Encoders, IMU, foot forces and the base's true pose and velocity."""
-        states = self.client.getJointStates(self.body, self.joint_indices)
+        """Encoders, IMU, foot forces and the base's true pose and velocity (joints in
+        the rigid-body model's order, :class:`kinematics.robot_model.RobotModel`)."""
+        states = self.client.getJointStates(self.body, self._model_indices)
         position, quaternion = self.base_pose()
         inertial_position, _ = self.client.getBasePositionAndOrientation(self.body)
         linear, angular = self.client.getBaseVelocity(self.body)
@@ -331,7 +333,7 @@ class SimulatedRobot:
         self._motor_target = command.position.copy()
         for step in range(1, steps + 1):
             states = pybullet.getJointStates(
-                self.body, self.joint_indices, physicsClientId=self._client_id
+                self.body, self._model_indices, physicsClientId=self._client_id
             )
             torques = motors.torques(
                 step / steps,
@@ -340,7 +342,7 @@ class SimulatedRobot:
             )
             self._set_motors(
                 self.body,
-                self.joint_indices,
+                self._model_indices,
                 pybullet.TORQUE_CONTROL,
                 forces=torques.tolist(),
                 physicsClientId=self._client_id,

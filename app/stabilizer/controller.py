@@ -64,6 +64,15 @@ class ControllerOptions:
     settle_from_swing: bool = False
     compensate_touch: bool = False
     settle: bool = True
+    gain_rule: bool = False
+    flywheel_return_time: float = 0.5
+    flywheel_momentum: float = 2.0
+    flywheel_cancel: float = 0.5
+    flywheel_offset: float = 0.4
+    joint_saturation: float = 0.1
+    ankle_saturation: float = 1.0
+    damping_time: float = 0.025
+    ankle_damping_time: float = 0.05
     landing_window: float = 0.1
 
 
@@ -84,6 +93,8 @@ class WholeBodyController:
         self.model = RobotModel(description)
         self.mass = self.model.mass
         self.estimator = StateEstimator(self.model, self.options.estimator)
+        if not description.upper_body_joints:
+            upper_body_momentum = 0.0
         self.ik = WholeBodyIK(description, upper_body=upper_body_momentum > 0.0)
         self._ik_to_model = np.array([self.ik.joint_names.index(n) for n in self.model.joint_names])
         self.flywheel: UpperBodyFlywheel | None = None
@@ -92,9 +103,10 @@ class WholeBodyController:
                 self.ik.robot,
                 self.ik.upper_body_joints,
                 self.ik.upper_body_posture,
-                return_time=0.5,
-                max_momentum=upper_body_momentum,
-                cancel=0.5,
+                return_time=self.options.flywheel_return_time,
+                max_momentum=self.options.flywheel_momentum,
+                cancel=self.options.flywheel_cancel,
+                max_offset=self.options.flywheel_offset,
             )
         self.timing = timing
         self.swing = SwingFootTrajectory(
@@ -110,10 +122,17 @@ class WholeBodyController:
         self.limits = ContactLimits(description.sole, friction=self.options.friction)
         names = self.model.joint_names
         o = self.options
-        self.stiffness = np.array(
+        if o.gain_rule:
+            effort = self.model.effort_limits
+            ankle = np.array(["ankle" in n or n.endswith(("_5_joint", "_6_joint")) and n.startswith("leg") for n in names])
+            saturation = np.where(ankle, o.ankle_saturation, o.joint_saturation)
+            self.stiffness = effort / saturation
+            self.damping = self.stiffness * np.where(ankle, o.ankle_damping_time, o.damping_time)
+        else:
+          self.stiffness = np.array(
             [UNITREE_STIFFNESS[_group(n)] * (o.ankle_stiffness_scale if "ankle" in n else o.stiffness_scale) for n in names]
         )
-        self.damping = np.array(
+          self.damping = np.array(
             [UNITREE_DAMPING[_group(n)] * (o.ankle_damping_scale if "ankle" in n else o.damping_scale) for n in names]
         )
         self.ankle_height = -float(description.sole_offset[2])
