@@ -29,8 +29,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
-from .lowlevel import JointCommand
 from kinematics.robot_model import RobotModel
+
+from .lowlevel import JointCommand
 
 
 class JointMotors:
@@ -77,7 +78,8 @@ class JointMotors:
         self._stiffness[6:] = command.stiffness
         self._damping[6:] = command.damping
         nv = model.nv
-        self._inverse = np.linalg.inv(model.mass_matrix() + np.diag(self._damping) * self.time_step)
+        damped = model.mass_matrix() + np.diag(self._damping) * self.time_step
+        self._inverse = np.asarray(np.linalg.inv(damped), dtype=np.float64)
         feedforward = np.zeros(nv)
         feedforward[6:] = command.torque
         self._bias = feedforward + contact_force - model.inverse_dynamics(np.zeros(nv))

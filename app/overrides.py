@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import inspect
 import re
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -100,20 +99,14 @@ MAX_VALUE_LENGTH = 1000
 _NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?", re.ASCII)
 _INTEGER = re.compile(r"[+-]?\d{1,9}", re.ASCII)
 
-#: Backend keyword arguments that are not options of a run.
-_NOT_BACKEND_OPTIONS = {"self", "robot", "timing"}
-
 
 def backend_option_types() -> dict[str, str]:
-    """PyBullet backend option -> its annotation (``"float"``, ``"bool"``, ...)."""
-    from .pybullet_backend import PyBulletBackend
+    """PyBullet backend option -> its annotation (``"float"``, ``"str"``, ...): the
+    whole-body stabilizer's options and the control period."""
+    from app.stabilizer.config import StabilizerConfig
 
-    parameters = inspect.signature(PyBulletBackend.__init__).parameters
-    return {
-        name: str(parameter.annotation)
-        for name, parameter in parameters.items()
-        if name not in _NOT_BACKEND_OPTIONS
-    }
+    types = {field.name: str(field.type) for field in dataclasses.fields(StabilizerConfig)}
+    return {**types, "control_period": "float"}
 
 
 def _paper_point_mass(model: str, robot: str | None) -> bool:
@@ -336,8 +329,6 @@ def apply_to_description(
     if not parsed.description and not parsed.backend:
         return description
     fields = dict(parsed.description)
-    if "physics_time_step" in fields:  # with the gains that keep the servos' time constants
-        description = description.with_physics_time_step(fields.pop("physics_time_step"))
     options = {**description.backend_options, **parsed.backend}
     return dataclasses.replace(description, **fields, backend_options=options)
 

@@ -1,17 +1,21 @@
-"""A biped in its own PyBullet world: loading, state measurement, actuation.
+"""A biped in its own PyBullet world: loading, its sensors and its joint motors.
 
 One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
 coexist in a process), a flat ground with friction, and the robot loaded from the
 derived URDF with the URDF's inertias, its fixed-joint links merged into their
 parents (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per
 physics step; a ground contact of the head is reported as one of ``torso_link``).
+PyBullet's own joint motors are off (``VELOCITY_CONTROL`` with zero force): the
+joints are torque-driven by :class:`app.joint_motors.JointMotors`, the G1's low-level
+PD law with feed-forward, at every physics step (:meth:`actuate`); :meth:`measure`
+gives the low-level measurement record (:mod:`app.lowlevel`).
 Frames: PyBullet's base pose is the base link's *inertial* frame;
 :meth:`base_pose` converts it to the URDF base frame.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 import pybullet
@@ -41,7 +45,7 @@ class SimulatedRobot:
         time: Simulated time [s].
     """
 
-    def __init__(self, description: RobotDescription, torque_control: bool = False) -> None:
+    def __init__(self, description: RobotDescription) -> None:
         self.description = description
         self.time_step = description.physics_time_step
         self.client = BulletClient(connection_mode=pybullet.DIRECT)
@@ -88,11 +92,6 @@ class SimulatedRobot:
         self.mass = float(self.link_masses.sum())
         base_info = client.getDynamicsInfo(self.body, -1)
         self._base_inertial = (base_info[3], base_info[4])
-        gains = [description.gains_of(name) for name in self.joint_names]
-        self._position_gains = [g.position_gain for g in gains]
-        self._velocity_gains = [g.velocity_gain for g in gains]
-        self._max_forces = [g.max_force for g in gains]
-        self._zero_velocities = [0.0] * len(self.joint_names)
         # The module functions with the client id: BulletClient's per-call
         # attribute lookup (a functools.partial each time) costs ~1 us per call.
         self._client_id = client._client
@@ -100,14 +99,13 @@ class SimulatedRobot:
         self._step_simulation = pybullet.stepSimulation
         self._contacts: tuple | None = None  # contact points of the current state
         self.time = 0.0
-        self.motors: JointMotors | None = None
-        if torque_control:
-            model = RobotModel(description)
-            # The low-level interface orders joints as the rigid-body model does.
-            self._model_order = [self.joint_names.index(name) for name in model.joint_names]
-            self._model_indices = [self.joint_indices[i] for i in self._model_order]
-            self.motors = JointMotors(model, self.time_step)
-            self._motor_target = np.zeros(len(self.joint_names))
+        model = RobotModel(description)
+        # The low-level interface orders joints as the rigid-body model does.
+        self._model_indices = [
+            self.joint_indices[self.joint_names.index(name)] for name in model.joint_names
+        ]
+        self.motors = JointMotors(model, self.time_step)
+        self._motor_target = np.zeros(len(self.joint_names))
 
     # ----------------------------------------------------------------- state
     def set_configuration(
@@ -246,27 +244,6 @@ class SimulatedRobot:
         _, rotation = self._foot_frame(foot, True)
         return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
 
-    # ------------------------------------------------------------- actuation
-    def set_joint_targets(
-        self, angles: NDArray[np.float64], velocities: NDArray[np.float64] | None = None
-    ) -> None:
-        """Position targets [rad] (and velocity targets [rad/s]) in joint_names order.
-
-        Called at every physics step: the arguments go to PyBullet as plain lists
-        and the gains are prepared once (measured 8.4 -> 4.2 us per call).
-        """
-        self._set_motors(
-            self.body,
-            self.joint_indices,
-            pybullet.POSITION_CONTROL,
-            targetPositions=angles.tolist(),
-            targetVelocities=self._zero_velocities if velocities is None else velocities.tolist(),
-            positionGains=self._position_gains,
-            velocityGains=self._velocity_gains,
-            forces=self._max_forces,
-            physicsClientId=self._client_id,
-        )
-
     # ------------------------------------------------------- torque control
     def measure(self) -> RobotMeasurement:
         """Encoders, IMU, foot forces and the base's true pose and velocity (joints in
@@ -277,7 +254,9 @@ class SimulatedRobot:
         linear, angular = self.client.getBaseVelocity(self.body)
         rotation = np.array(self.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
         # PyBullet's base velocity is that of the inertial frame origin.
-        origin_velocity = np.array(linear) + np.cross(angular, position - np.array(inertial_position))
+        origin_velocity = np.array(linear) + np.cross(
+            angular, position - np.array(inertial_position)
+        )
         forces = {
             foot: FootForce(force, cop) for foot, (cop, force) in self.foot_pressure().items()
         }
@@ -303,17 +282,16 @@ class SimulatedRobot:
         steps: int,
         expected_contact_force: NDArray[np.float64],
         base_force_world: NDArray[np.float64] | None = None,
+        observer: Callable[[SimulatedRobot, NDArray[np.float64] | None], None] | None = None,
     ) -> None:
         """Run ``steps`` physics steps with the motors on ``command`` (torque control).
 
         ``measurement`` is the state at the start of the tick (the motors' model
         uses its true base state); ``expected_contact_force`` is J^T f of the contact
         forces expected over the tick (:mod:`app.joint_motors`). ``base_force_world``
-        [N] pushes the pelvis.
+        [N] pushes the pelvis; ``observer`` is called after each physics step.
         """
         motors = self.motors
-        if motors is None:
-            raise ValueError("actuate() needs a robot built with torque_control=True")
         model = motors.model
         q = np.concatenate(
             [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
@@ -348,6 +326,8 @@ class SimulatedRobot:
                 physicsClientId=self._client_id,
             )
             self.step(base_force_world)
+            if observer is not None:
+                observer(self, base_force_world)
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step (``time_step`` [s]) with a force [N] on the base CoM.

@@ -48,12 +48,24 @@ class RobotModel:
             foot: self.model.getFrameId(description.ankle_link(foot)) for foot in FEET
         }
         self.effort_limits = np.asarray(self.model.effortLimit[6:], float).copy()
+        # The two joints nearest each sole (ankle pitch and roll on G1 and Talos).
+        self._ankle_joints = set()
+        for frame in self._ankle_frames.values():
+            joint = self.model.frames[frame].parentJoint
+            self._ankle_joints |= {
+                self.model.names[joint],
+                self.model.names[self.model.parents[joint]],
+            }
         self.q = pinocchio.neutral(self.model)
         self.v = np.zeros(self.model.nv)
 
     @property
     def nv(self) -> int:
         return int(self.model.nv)
+
+    def is_ankle(self, joint: str) -> bool:
+        """Whether ``joint`` is one of the two joints nearest a sole."""
+        return joint in self._ankle_joints
 
     def index_of(self, names: Sequence[str]) -> NDArray[np.intp]:
         """Positions in ``joint_names`` of each of ``names``."""

@@ -144,7 +144,9 @@ def distribute_wrench(
             ``min_force`` is below every ``max_force``).
     """
     if len(contacts) == 1:
-        return [_single_support(contacts[0], np.asarray(force, float), np.asarray(cop, float), limits)]
+        return [
+            _single_support(contacts[0], np.asarray(force, float), np.asarray(cop, float), limits)
+        ]
     count = len(contacts)
     size = 6 * count
     scale = max(float(force[2]), 1.0)  # [N]
@@ -175,7 +177,10 @@ def distribute_wrench(
 
 
 def _single_support(
-    contact: FootContact, force: NDArray[np.float64], cop: NDArray[np.float64], limits: ContactLimits
+    contact: FootContact,
+    force: NDArray[np.float64],
+    cop: NDArray[np.float64],
+    limits: ContactLimits,
 ) -> NDArray[np.float64]:
     """The QP's solution for one foot in closed form: the force within the friction
     pyramid, the CoP clipped to the sole, no torsion."""
@@ -196,6 +201,9 @@ def center_of_pressure(
     contacts: Sequence[FootContact], wrenches: Sequence[NDArray[np.float64]]
 ) -> NDArray[np.float64]:
     """CoP [m] of the wrenches (f, m) taken at the contacts' sole points, shape (2,)."""
-    force = sum(w[:3] for w in wrenches)
-    moment = sum(w[3:] + np.cross(c.sole_point, w[:3]) for c, w in zip(contacts, wrenches, strict=True))
+    force = np.sum([w[:3] for w in wrenches], axis=0)
+    moment = np.sum(
+        [w[3:] + np.cross(c.sole_point, w[:3]) for c, w in zip(contacts, wrenches, strict=True)],
+        axis=0,
+    )
     return np.array([-moment[1], moment[0]]) / force[2]

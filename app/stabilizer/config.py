@@ -1,0 +1,80 @@
+"""The whole-body stabilizer's options: one typed record, checked when built."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+from planner.exceptions import ParameterError
+
+from .estimator import SOURCES
+
+
+@dataclass(frozen=True)
+class StabilizerConfig:
+    """Options of :class:`app.stabilizer.controller.WholeBodyController` (units in brackets).
+
+    Attributes:
+        estimator: Where the floating base's position and velocity come from:
+            ``"truth"`` (the simulator) or ``"odometry"`` (leg odometry from the stance
+            sole, encoders and IMU, what a real G1 has).
+        stiffness_angle: Joint error [rad] at which a joint's PD uses its whole effort
+            limit: kp = effort / angle. Small: joints track the IK closely.
+        ankle_stiffness_angle: The same for the ankles [rad]; large, because the
+            ankle torque that places the CoP comes from the feed-forward.
+        damping_time: kd / kp of the joints [s].
+        ankle_damping_time: kd / kp of the ankles [s].
+        landing_depth: How far below the ground the swing sole aims at the planned
+            landing time [m], so it touches down by then rather than after.
+        landing_admittance: Landing compliance [m/(N s)]: a touching swing sole
+            rises at this speed per newton it carries above ``touch_force``.
+        touch_force: Load a touching swing sole is allowed [-, fraction of m g].
+        friction: Coulomb coefficient of the wrench distribution's contacts [-].
+        flywheel_momentum: h_max, angular momentum the upper body may carry [N m s]
+            (0: no flywheel; the whole hdot goes to the CoP).
+        flywheel_return_time: T_r, band-pass of hdot for the flywheel and its return
+            to the posture [s].
+        flywheel_cancel: Share of the legs' high-passed angular momentum the upper
+            body takes back [-].
+    """
+
+    estimator: str = "truth"
+    stiffness_angle: float = 0.1
+    ankle_stiffness_angle: float = 1.0
+    damping_time: float = 0.025
+    ankle_damping_time: float = 0.05
+    landing_depth: float = 0.005
+    landing_admittance: float = 0.003
+    touch_force: float = 0.05
+    friction: float = 0.7
+    flywheel_momentum: float = 2.0
+    flywheel_return_time: float = 0.5
+    flywheel_cancel: float = 0.5
+
+    def __post_init__(self) -> None:
+        if self.estimator not in SOURCES:
+            raise ParameterError("estimator", self.estimator, " or ".join(SOURCES))
+        for name, (low, high) in RANGES.items():
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ParameterError(name, value, f"a number in [{low:g}, {high:g}]")
+            if not (math.isfinite(value) and low <= value <= high):
+                raise ParameterError(name, value, f"a number in [{low:g}, {high:g}]")
+
+
+#: Physically meaningful range of each number option (units as in the attributes).
+RANGES: dict[str, tuple[float, float]] = {
+    "stiffness_angle": (0.01, 10.0),
+    "ankle_stiffness_angle": (0.01, 10.0),
+    "damping_time": (0.0, 0.2),
+    "ankle_damping_time": (0.0, 0.2),
+    "landing_depth": (0.0, 0.02),
+    "landing_admittance": (0.0, 0.05),
+    "touch_force": (0.0, 1.0),
+    "friction": (0.1, 2.0),
+    "flywheel_momentum": (0.0, 10.0),
+    "flywheel_return_time": (0.05, 10.0),
+    "flywheel_cancel": (0.0, 1.0),
+}
+
+OPTION_NAMES = tuple(field.name for field in fields(StabilizerConfig))
