@@ -23,7 +23,7 @@ RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
 (``step_max=0.35,0.4``), ``none`` where the option allows it, or a word for a
-string option (``plan_angular_momentum=feedback``), or comma-separated joint names
+string option (``estimator=odometry``), or comma-separated joint names
 (``locked_joints=none`` actuates every joint). Numbers are ASCII decimals (no nan,
 inf, hex or ``_``). Each parameter has a range, defined where the parameter is (the
 planner's ``planner.parameters.RANGES``, the description, the backend's
