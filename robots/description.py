@@ -33,6 +33,25 @@ PLANNER_FIELDS = (
 )
 
 
+@dataclass(frozen=True)
+class JointImpedance:
+    """A joint motor's PD gains (the G1 low level's kp and kd).
+
+    Attributes:
+        stiffness: kp [N m/rad], > 0.
+        damping: kd [N m s/rad], >= 0.
+    """
+
+    stiffness: float
+    damping: float
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.stiffness) and 0.0 < self.stiffness <= 1e5):
+            raise ParameterError("stiffness", self.stiffness, "a number in (0, 1e5] N m/rad")
+        if not (math.isfinite(self.damping) and 0.0 <= self.damping <= 1e3):
+            raise ParameterError("damping", self.damping, "a number in [0, 1e3] N m s/rad")
+
+
 def _check_physics_time_step(value: float) -> None:
     """Raise a ParameterError naming ``physics_time_step`` unless 0.5 ms <= value <= 5 ms."""
     if not (isinstance(value, float) and 0.0005 <= value <= 0.005):
@@ -79,6 +98,8 @@ class RobotDescription:
         foot_spacing: Nominal lateral distance between the two ankles [m].
         standing_posture: Joint name -> angle [rad] of the nominal posture; joints
             not listed are at 0 rad.
+        joint_impedance: Joint name -> its motor's PD gains, for every actuated
+            joint that is not locked.
         total_mass: Mass from the URDF [kg] (checked against PyBullet in the tests).
         fall_base_height: Pelvis height [m] under which the robot counts as fallen.
         fall_tilt: Pelvis tilt from vertical [rad] over which it counts as fallen.
@@ -138,6 +159,7 @@ class RobotDescription:
     com_height: float
     foot_spacing: float
     standing_posture: Mapping[str, float]
+    joint_impedance: Mapping[str, JointImpedance]
     total_mass: float
     fall_base_height: float = 0.4
     fall_tilt: float = math.radians(45.0)
@@ -220,6 +242,7 @@ class RobotDescription:
         # Freeze the mappings so the description stays immutable and hashable-safe.
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
         object.__setattr__(self, "backend_options", MappingProxyType(dict(self.backend_options)))
+        object.__setattr__(self, "joint_impedance", MappingProxyType(dict(self.joint_impedance)))
 
     def ankle_link(self, foot: str) -> str:
         """Ankle link name of ``foot`` (``"left"`` or ``"right"``)."""

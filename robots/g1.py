@@ -34,7 +34,7 @@ under position control, kept since):
 
 from __future__ import annotations
 
-from robots.description import RobotDescription, SoleRectangle
+from robots.description import JointImpedance, RobotDescription, SoleRectangle
 
 _LEG_BEND = {"hip_pitch": -0.35, "knee": 0.7, "ankle_pitch": -0.35}
 _ARMS = {"shoulder_pitch": 0.2, "elbow": 0.9}
@@ -55,6 +55,44 @@ STANDING_POSTURE = {
     "right_shoulder_roll_joint": -_SHOULDER_ROLL,
 }
 
+# Unitree's published PD gains (kp [N m/rad], kd [N m s/rad]): legs from unitree_rl_gym,
+# legged_gym/envs/g1/g1_config.py; waist and arms from unitree_sdk2,
+# example/g1/low_level/g1_ankle_swing_example.cpp.
+PUBLISHED_GAINS = {
+    "hip": (150.0, 2.0),
+    "knee": (300.0, 4.0),
+    "ankle": (40.0, 2.0),
+    "waist_yaw": (60.0, 1.0),
+    "waist": (40.0, 1.0),
+    "shoulder": (40.0, 1.0),
+}
+# Those gains serve a learned policy that closes its own loop at 50 Hz; tracking the IK
+# with a feed-forward here, the joints but the ankles take 5 x kp and 10 x kd (the
+# ankles keep theirs: their torque that places the CoP comes from the feed-forward).
+STIFFNESS_FACTOR, DAMPING_FACTOR = 5.0, 10.0
+
+
+def _impedance(joint: str) -> JointImpedance:
+    group = next(
+        g for g in ("waist_yaw", "hip", "knee", "ankle", "waist", "shoulder") if g in joint
+    )
+    kp, kd = PUBLISHED_GAINS[group]
+    if group == "ankle":
+        return JointImpedance(kp, kd)
+    return JointImpedance(STIFFNESS_FACTOR * kp, DAMPING_FACTOR * kd)
+
+
+_ACTUATED = [
+    f"{side}_{joint}_joint"
+    for side in ("left", "right")
+    for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
+] + [
+    "waist_yaw_joint",
+    "waist_roll_joint",
+    "waist_pitch_joint",
+    *(f"{side}_shoulder_{axis}_joint" for side in ("left", "right") for axis in ("pitch", "roll")),
+]
+
 G1 = RobotDescription(
     name="g1",
     urdf_source="g1_description/urdf/g1_29dof_rev_1_0.urdf",
@@ -67,6 +105,7 @@ G1 = RobotDescription(
     com_height=0.66,
     foot_spacing=0.23,
     standing_posture=STANDING_POSTURE,
+    joint_impedance={joint: _impedance(joint) for joint in _ACTUATED},
     total_mass=33.3,
     physics_time_step=0.002,
     solver_iterations=75,

@@ -18,7 +18,7 @@ and the whole hdot goes to the CoP.
 
 from __future__ import annotations
 
-from robots.description import RobotDescription, SoleRectangle
+from robots.description import JointImpedance, RobotDescription, SoleRectangle
 
 # Half-sitting posture of talos.srdf (legs and arms; torso and head at 0). Leg joints
 # 1-6: hip yaw, hip roll, hip pitch, knee, ankle pitch, ankle roll; the right arm's
@@ -40,6 +40,29 @@ STANDING_POSTURE = {
     },
 }
 
+# The URDF's effort limits [N m]. No PD gains are published for Talos: each joint uses
+# its whole effort at 0.1 rad of error, with kd = 0.025 s x kp, and the ankles (joints 5
+# and 6, whose CoP-placing torque comes from the feed-forward) at 1 rad, kd = 0.05 s x kp.
+_LEG_EFFORTS = {"1": 100.0, "2": 160.0, "3": 160.0, "4": 300.0, "5": 160.0, "6": 100.0}
+_ARM_EFFORTS = {"1": 44.64, "2": 22.32, "3": 17.86, "4": 17.86, "5": 3.0, "6": 6.6, "7": 6.6}
+_EFFORTS = {
+    **{f"leg_{s}_{j}_joint": e for s in ("left", "right") for j, e in _LEG_EFFORTS.items()},
+    **{f"arm_{s}_{j}_joint": e for s in ("left", "right") for j, e in _ARM_EFFORTS.items()},
+    "torso_1_joint": 78.0,
+    "torso_2_joint": 78.0,
+    "gripper_left_joint": 1.0,
+    "gripper_right_joint": 1.0,
+    "head_1_joint": 8.0,
+    "head_2_joint": 4.0,
+}
+
+
+def _impedance(joint: str, effort: float) -> JointImpedance:
+    ankle = joint.startswith("leg_") and joint.endswith(("_5_joint", "_6_joint"))
+    angle, damping_time = (1.0, 0.05) if ankle else (0.1, 0.025)
+    return JointImpedance(effort / angle, damping_time * effort / angle)
+
+
 TALOS = RobotDescription(
     name="talos",
     urdf_source="talos_data/robots/talos_reduced.urdf",
@@ -52,6 +75,7 @@ TALOS = RobotDescription(
     com_height=0.87,
     foot_spacing=0.17,
     standing_posture=STANDING_POSTURE,
+    joint_impedance={joint: _impedance(joint, effort) for joint, effort in _EFFORTS.items()},
     total_mass=90.27,
     fall_base_height=0.6,
     swing_height=0.06,

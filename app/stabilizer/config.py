@@ -18,12 +18,6 @@ class StabilizerConfig:
         estimator: Where the floating base's position and velocity come from:
             ``"truth"`` (the simulator) or ``"odometry"`` (leg odometry from the stance
             sole, encoders and IMU, what a real G1 has).
-        stiffness_angle: Joint error [rad] at which a joint's PD uses its whole effort
-            limit: kp = effort / angle. Small: joints track the IK closely.
-        ankle_stiffness_angle: The same for the ankles [rad]; large, because the
-            ankle torque that places the CoP comes from the feed-forward.
-        damping_time: kd / kp of the joints [s].
-        ankle_damping_time: kd / kp of the ankles [s].
         landing_depth: How far below the ground the swing sole aims at the planned
             landing time [m], so it touches down by then rather than after.
         landing_admittance: Landing compliance [m/(N s)]: a touching swing sole
@@ -39,10 +33,6 @@ class StabilizerConfig:
     """
 
     estimator: str = "truth"
-    stiffness_angle: float = 0.1
-    ankle_stiffness_angle: float = 1.0
-    damping_time: float = 0.025
-    ankle_damping_time: float = 0.05
     landing_depth: float = 0.005
     landing_admittance: float = 0.003
     touch_force: float = 0.05
@@ -64,10 +54,6 @@ class StabilizerConfig:
 
 #: Physically meaningful range of each number option (units as in the attributes).
 RANGES: dict[str, tuple[float, float]] = {
-    "stiffness_angle": (0.01, 10.0),
-    "ankle_stiffness_angle": (0.01, 10.0),
-    "damping_time": (0.0, 0.2),
-    "ankle_damping_time": (0.0, 0.2),
     "landing_depth": (0.0, 0.02),
     "landing_admittance": (0.0, 0.05),
     "touch_force": (0.0, 1.0),

@@ -23,6 +23,7 @@ from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
+from planner.exceptions import ParameterError
 from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import GRAVITY, LipmModel
 from planner.types import Foot, MeasuredState, PlannerOutput, other_foot
@@ -101,7 +102,7 @@ class WholeBodyController:
             timing.double_support,
         )
         self.limits = ContactLimits(description.sole, friction=config.friction)
-        self.stiffness, self.damping = joint_impedance(self.model, config)
+        self.stiffness, self.damping = joint_impedance(self.model, description)
         self._ankle_height = -float(description.sole_offset[2])
         self.expected_contact_force = np.zeros(self.model.nv)
         self.state: RobotState | None = None
@@ -309,15 +310,17 @@ class WholeBodyController:
 
 
 def joint_impedance(
-    model: RobotModel, config: StabilizerConfig
+    model: RobotModel, description: RobotDescription
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Per-joint stiffness [N m/rad] and damping [N m s/rad] from the effort limits.
+    """Per-joint stiffness [N m/rad] and damping [N m s/rad] in the model's joint order.
 
-    A joint reaches its effort limit at ``stiffness_angle`` of error (the ankles at
-    ``ankle_stiffness_angle``), and its damping is kp times ``damping_time``.
+    Raises:
+        ParameterError: A joint of the model has no gains in the description.
     """
-    ankles = np.array([model.is_ankle(name) for name in model.joint_names])
-    angle = np.where(ankles, config.ankle_stiffness_angle, config.stiffness_angle)
-    stiffness = model.effort_limits / angle
-    damping = stiffness * np.where(ankles, config.ankle_damping_time, config.damping_time)
-    return stiffness, damping
+    missing = [name for name in model.joint_names if name not in description.joint_impedance]
+    if missing:
+        raise ParameterError(
+            "joint_impedance", missing, f"gains for every joint of {description.name}"
+        )
+    gains = [description.joint_impedance[name] for name in model.joint_names]
+    return np.array([g.stiffness for g in gains]), np.array([g.damping for g in gains])
