@@ -29,18 +29,17 @@ def command(
 ) -> PlannerOutput:
     """A planner command: the ZMP ``zmp`` [m] on ``stance``, ``since_step`` [s] after
     the last step, the next step ``next_step`` (default: ``swing``) at the step
-    duration."""
+    duration; hdot [N m] and its feedback part default to zero."""
     zmp = np.asarray(zmp, float)
-    rate = np.zeros(2) if angular_momentum_rate is None else angular_momentum_rate
-    feedback = (
-        np.zeros(2) if angular_momentum_rate_feedback is None else angular_momentum_rate_feedback
-    )
+    zero = np.zeros(2)
+    rate = zero if angular_momentum_rate is None else angular_momentum_rate
+    feedback = zero if angular_momentum_rate_feedback is None else angular_momentum_rate_feedback
     return PlannerOutput(
         time=time,
         zmp=zmp,
         zmp_offset=np.zeros(2),
         window_center=zmp,
-        angular_momentum_rate=rate + feedback,
+        angular_momentum_rate=rate,
         angular_momentum_rate_feedback=feedback,
         stance=stance,
         previous_stance=swing,
