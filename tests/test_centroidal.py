@@ -41,7 +41,7 @@ def test_the_planners_zmp_and_hdot_give_the_pivot_where_the_force_line_meets_the
 
 
 def test_without_angular_momentum_rate_the_cop_is_the_pivot():
-    for com, zmp, _ in cases(10):
+    for _, zmp, _ in cases(10):
         r = pivot(zmp, np.zeros(2), MODEL.mass)
         np.testing.assert_array_equal(r, zmp)
         for double_support in (True, False):
