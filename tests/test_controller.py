@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from robot_commands import LEFT, RIGHT, command
 from scipy.spatial.transform import Rotation
 
 from app.lowlevel import FootForce, JointCommand, RobotMeasurement
 from app.stabilizer.config import StabilizerConfig
 from app.stabilizer.controller import WholeBodyController
+from conftest import LEFT, RIGHT, command
 from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingTiming
 from kinematics.whole_body_ik import sole_pose
@@ -120,7 +120,7 @@ for name in ("pybullet", "pybullet_data", "pybullet_utils", "pybullet_utils.bull
     sys.modules[name] = None  # any import of PyBullet fails
 sys.path.insert(0, "tests")
 from test_controller import standing
-from robot_commands import command
+from conftest import command
 import numpy as np
 controller, measurement = standing()
 order = controller.tick(measurement, command(0.0, np.zeros(2)))

@@ -8,7 +8,6 @@ import dataclasses
 import numpy as np
 import pybullet
 import pytest
-from robot_commands import LEFT, RIGHT, command, dcm_feedback_zmp
 
 from app.backend import InitialCondition
 from app.lowlevel import JointCommand
@@ -16,6 +15,7 @@ from app.pybullet_backend import PyBulletBackend
 from app.pybullet_robot import SimulatedRobot
 from app.stabilizer.config import StabilizerConfig
 from app.stabilizer.controller import joint_impedance
+from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from robots import get_robot
 
 G1 = get_robot("g1")

@@ -7,10 +7,10 @@ import dataclasses
 
 import numpy as np
 import pytest
-from robot_commands import LEFT, RIGHT, command, dcm_feedback_zmp
 
 from app.backend import InitialCondition
 from app.pybullet_backend import PyBulletBackend
+from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from planner.exceptions import ParameterError
 from planner.parameters import GRAVITY
 from planner.types import Foothold, StepEvent

@@ -7,10 +7,10 @@ import dataclasses
 import numpy as np
 import pinocchio
 import pytest
-from robot_commands import LEFT, RIGHT, command, dcm_feedback_zmp
 
 from app.backend import InitialCondition
 from app.pybullet_backend import PyBulletBackend
+from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
