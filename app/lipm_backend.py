@@ -20,6 +20,8 @@ from planner.types import MeasuredState, PlannerOutput, Vector2
 
 from .backend import FallStatus, InitialCondition
 
+LEG_REACH = 0.6  # [m] CoM to stance-ankle distance beyond which the LIPM counts a fall
+
 
 class LipmBackend:
     """Closed-form LIPM (1) with the planner's ZMP and angular momentum.
@@ -37,7 +39,7 @@ class LipmBackend:
         self,
         model: LipmModel,
         control_period: float = 0.001,
-        fall_distance: float = 0.6,
+        fall_distance: float = LEG_REACH,
         fall_dcm_error: float = 0.5,
     ) -> None:
         self.model = model

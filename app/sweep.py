@@ -2,8 +2,9 @@
 
 Jobs: one job is (controller, direction, phase). It bisects the impulse magnitude
 [N s] of a single push along the direction between 0 and ``bracket`` times the
-capturability bound (:mod:`app.capturability`) and returns the largest impulse that
-is still recovered, to ``tolerance``. Recovery is assumed monotone in the magnitude.
+capture bound (:mod:`app.capturability`, an upper limit for any controller on the
+LIPM) and returns the largest impulse that is still recovered, to ``tolerance``.
+Recovery is assumed monotone in the magnitude.
 
 Push phase: the LIPM walk starts in single support on the left foot at s~ = T_DSP,
 so nominal step k (k = 1, 2, ...) lands at t_k = T_SSP + (k - 1) T^*. Cycle k is
@@ -127,7 +128,7 @@ class SweepSpec:
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
         tolerance: Bisection tolerance on the impulse [N s].
-        bracket: Upper end of the bisection, times the capturability bound [-].
+        bracket: Upper end of the bisection, times the capture bound [-].
         qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
         criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM

@@ -47,7 +47,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
         "sweep",
         help="robustness map: largest recovered impulse per controller, direction and phase",
         description="Bisect, for each controller, push direction and push phase, the largest "
-        "impulse that is still recovered, next to the LIPM's N-step capturability bound.",
+        "impulse that is still recovered, next to the capture bound (an upper limit for any "
+        "controller on the LIPM).",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
