@@ -10,6 +10,7 @@ from pathlib import Path
 from .overrides import add_robot_argument, add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
 from .robot_setup import check_robot_overrides
+from .setup import PAPER_RULES_HELP
 from .sweep import SWEEP_CONTROLLERS
 
 EPILOG = """\
@@ -71,8 +72,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
         default=GridSpec.settle,
         help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
     )
-    p.add_argument("--paper-rules", action="store_true",
-                   help="the RSG without the documented extensions")  # fmt: skip
+    p.add_argument("--paper-rules", action="store_true", help=PAPER_RULES_HELP)
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
     add_set_argument(p)

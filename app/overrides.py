@@ -97,11 +97,12 @@ def _paper_point_mass(model: str, robot: str | None) -> bool:
 
 
 def rsg_parameter_types(model: str = "pybullet", robot: str | None = None) -> dict[str, str]:
-    """RSG parameters ``--set`` may change on ``model`` -> ``"float"``: all of them on
-    the paper's LIPM; with a robot those its description does not set."""
+    """RSG parameters ``--set`` may change on ``model`` -> ``"float"`` (``"bool"`` for a
+    switch): all of them on the paper's LIPM; with a robot those its description does
+    not set."""
     paper = _paper_point_mass(model, robot)
     return {
-        f.name: "float"
+        f.name: "bool" if f.type in ("bool", bool) else "float"
         for f in dataclasses.fields(RsgParameters)
         if paper or (f.name not in DESCRIPTION_FIELDS and not f.name.startswith("lqr_"))
     }

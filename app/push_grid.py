@@ -58,7 +58,7 @@ class GridSpec:
         duration: Push duration [s].
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
-        paper_rules: The RSG without the documented extensions.
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """

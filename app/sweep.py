@@ -135,8 +135,7 @@ class SweepSpec:
             backend's own default (0.5 m) is a heuristic below the capturable DCM
             error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
-        paper_rules: The RSG without the documented extensions (push hold, leg
-            reach in the QP, step reaction time; :func:`app.setup.paper_rules`).
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """
 

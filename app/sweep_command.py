@@ -12,6 +12,7 @@ from planner.parameters import CONTROLLERS
 from .envelope import build_envelope, format_table, write_envelope
 from .overrides import add_robot_argument, add_set_argument
 from .robot_setup import check_robot_overrides
+from .setup import PAPER_RULES_HELP
 from .sweep import PLACO_WPG, SweepSpec, run_sweep
 from .sweep_plot import plot_envelope
 
@@ -77,8 +78,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--paper-rules",
         action="store_true",
-        help="the RSG without the documented extensions (push hold, leg reach in the "
-        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
+        help=PAPER_RULES_HELP,
     )
     p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
     p.add_argument("--backend", choices=("process", "ray"), default="process",
