@@ -19,6 +19,7 @@ from planner.parameters import CONTROLLERS
 from .overrides import add_robot_argument, add_set_argument, parse_decimal
 from .result_folder import add_out_arguments
 from .scenarios import BUILT_IN, MAX_DURATION, parse_push
+from .setup import PAPER_RULES_HELP
 
 MODELS = ("lipm", "pybullet")
 DEFAULT_MODEL = "pybullet"
@@ -129,8 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--paper-rules",
         action="store_true",
-        help="the RSG without the documented extensions (push hold, leg reach in the "
-        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
+        help=PAPER_RULES_HELP,
     )
     add_set_argument(run)
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")

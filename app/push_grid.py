@@ -13,8 +13,8 @@ bisection can stop at any of several thresholds. The grid runs each
 
 Each record also carries the push's capture bound (:func:`app.capturability.impulse_bound`
 with the controller's configuration: the largest impulse in that direction and at
-that time that any stepping controller could recover on the LIPM with the robot's
-ZMP window, step bounds and step timing). A fall above it is a limit of the robot's
+that time that any controller could capture on the LIPM with the robot's ZMP window,
+step bounds, step timing and leg reach). A fall above it is a limit of the robot's
 parameters, not of a controller; the printed grid writes those outcomes in capitals.
 
 Counts over the grid compare controllers without the monotonicity assumption.
@@ -59,7 +59,7 @@ class GridSpec:
         duration: Push duration [s].
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
-        paper_rules: The RSG without the documented extensions.
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """

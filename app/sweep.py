@@ -2,8 +2,9 @@
 
 Jobs: one job is (controller, direction, phase). It bisects the impulse magnitude
 [N s] of a single push along the direction between 0 and ``bracket`` times the
-capturability bound (:mod:`app.capturability`) and returns the largest impulse that
-is still recovered, to ``tolerance``. Recovery is assumed monotone in the magnitude.
+capture bound (:mod:`app.capturability`, an upper limit for any controller on the
+LIPM) and returns the largest impulse that is still recovered, to ``tolerance``.
+Recovery is assumed monotone in the magnitude.
 
 Push phase: the LIPM walk starts in single support on the left foot at s~ = T_DSP,
 so nominal step k (k = 1, 2, ...) lands at t_k = T_SSP + (k - 1) T^*. Cycle k is
@@ -161,15 +162,14 @@ class SweepSpec:
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
         tolerance: Bisection tolerance on the impulse [N s].
-        bracket: Upper end of the bisection, times the capturability bound [-].
+        bracket: Upper end of the bisection, times the capture bound [-].
         qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
         criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
             backend's own default (0.5 m) is a heuristic below the capturable DCM
             error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
-        paper_rules: The RSG without the documented extensions (push hold, leg
-            reach in the QP, step reaction time; :func:`app.setup.paper_rules`).
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """
 

@@ -12,6 +12,7 @@ from .envelope import build_envelope, format_table, write_envelope
 from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .result_folder import add_out_arguments
 from .robot_setup import check_robot_overrides
+from .setup import PAPER_RULES_HELP
 from .sweep import PLACO_WPG, SweepSpec, check_workers, run_sweep
 from .sweep_plot import plot_envelope
 
@@ -48,7 +49,8 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
         "sweep",
         help="robustness map: largest recovered impulse per controller, direction and phase",
         description="Bisect, for each controller, push direction and push phase, the largest "
-        "impulse that is still recovered, next to the LIPM's N-step capturability bound.",
+        "impulse that is still recovered, next to the capture bound (an upper limit for any "
+        "controller on the LIPM).",
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -80,8 +82,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--paper-rules",
         action="store_true",
-        help="the RSG without the documented extensions (push hold, leg reach in the "
-        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
+        help=PAPER_RULES_HELP,
     )
     p.add_argument("--workers", type=int, default=None,
                    help="parallel workers (default: the CPU count; at most 4 per CPU, and "
