@@ -35,6 +35,7 @@ outputs in --out:
   summary.json     verdict (recovered, fell), steps, pushes, Lyapunov levels, counts
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
+  replay.npz       the run for the browser: rsg replay FOLDER
 """
 
 

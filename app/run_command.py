@@ -9,6 +9,7 @@ from pathlib import Path
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 
+from .replay import ReplayRecorder
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import load_scenario
@@ -93,6 +94,7 @@ def run_command(args: argparse.Namespace) -> int:
         physics_log = backend.physics_log = PhysicsLog()
     if overrides:
         print("with " + " ".join(f"--set {name}={value}" for name, value in overrides))
+    recorder = ReplayRecorder()
     try:
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:
@@ -107,6 +109,7 @@ def run_command(args: argparse.Namespace) -> int:
             initial,
             progress=ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet),
             planner=planner,
+            on_tick=recorder,
         )
         result.impulse_scale = factor
         if robot is not None:
@@ -127,5 +130,6 @@ def run_command(args: argparse.Namespace) -> int:
         print(f"wrote {physics_log.write(out / 'physics.csv')}")
     if not args.no_plots:
         print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
+    print(f"wrote {recorder.write(result, args.controller, robot, out)} (rsg replay {out})")
     print(verdict(result))
     return 0 if summary["recovered"] else 1

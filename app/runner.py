@@ -304,6 +304,7 @@ def run_closed_loop(
     progress: Callable[[float], None] | None = None,
     qp_solver: str = "proxqp",
     planner: PlannerFactory | None = None,
+    on_tick: Callable[[ClosedLoop, PlannerOutput], None] | None = None,
 ) -> RunResult:
     """Run ``scenario`` with the planner of ``config`` on ``backend``.
 
@@ -315,6 +316,8 @@ def run_closed_loop(
         progress: Called with the fraction done, about 100 times a run.
         qp_solver: ``"proxqp"`` or ``"exact"`` for the QP (27).
         planner: Builds another planner than the RSG (see :class:`ClosedLoop`).
+        on_tick: Called after every tick with the loop and the tick's output (e.g. a
+            :class:`app.replay.ReplayRecorder`).
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.
@@ -323,7 +326,9 @@ def run_closed_loop(
     ticks = int(round(scenario.duration / loop.period))
     report_every = max(1, ticks // 100)
     for tick in range(ticks):
-        loop.tick()
+        out = loop.tick()
+        if on_tick is not None:
+            on_tick(loop, out)
         if progress is not None and tick % report_every == 0:
             progress(tick / ticks)
         if backend.fall_status().fell:
