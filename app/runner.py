@@ -191,6 +191,8 @@ class ClosedLoop:
         capacity: Ticks to pre-allocate for the time series (grows when needed).
         planner: Builds the planner from ``config``; default the RSG
             (:class:`ReactiveStepGenerator` with ``qp_solver``).
+        record: Keep the time series and the steps (False: a loop that runs
+            without end, e.g. the live demo, keeps memory bounded).
     """
 
     def __init__(
@@ -202,8 +204,10 @@ class ClosedLoop:
         qp_solver: str = "proxqp",
         capacity: int | None = None,
         planner: PlannerFactory | None = None,
+        record: bool = True,
     ) -> None:
         self.backend = backend
+        self.record = record
         self.config = config
         self.scenario = scenario
         self.initial = initial or walking_start(config)
@@ -214,6 +218,8 @@ class ClosedLoop:
         )
         self.period = backend.control_period
         self._capacity = capacity or int(round(scenario.duration / self.period)) + 1
+        if not record:
+            self._capacity = 1
         self.reset()
 
     def reset(self) -> None:
@@ -251,22 +257,24 @@ class ClosedLoop:
         out = self.generator.update(measured, self.period)
         if out.step is not None:
             step = out.stance.position - out.previous_stance.position
-            self.steps.append(StepRecord(out.step.as_dict(), step.tolist()))
+            if self.record:
+                self.steps.append(StepRecord(out.step.as_dict(), step.tolist()))
             self.qp_infeasible += int(out.qp_infeasible)
             for name in _check_step(self.config, step, out.stance.foot):
                 self.violations[name] += 1
         for name in _check_tick(self.config, out, measured.com_position):
             self.violations[name] += 1
         force = self.scenario.force_average(time, self.period)
-        if self.ticks >= len(self.rows):
-            self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
-        self.rows[self.ticks] = (
-            time, *measured.com_position, *measured.com_velocity,
-            *out.zmp, *out.zmp_offset, *out.window_center,
-            *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
-            *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
-            *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
-        )  # fmt: skip
+        if self.record:
+            if self.ticks >= len(self.rows):
+                self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
+            self.rows[self.ticks] = (
+                time, *measured.com_position, *measured.com_velocity,
+                *out.zmp, *out.zmp_offset, *out.window_center,
+                *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
+                *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
+                *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
+            )  # fmt: skip
         self.measured = self.backend.step(out, force)
         self.ticks += 1
         self.last_output = out

@@ -8,7 +8,7 @@ import time
 import pytest
 
 from web.live import LiveSimulation
-from web.scene_model import paper_presets
+from web.push_input import paper_presets
 
 
 def wait_for(condition, timeout: float = 20.0) -> bool:
