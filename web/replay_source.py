@@ -32,7 +32,7 @@ def _foot(sigma: float) -> str:
 def _window(replay: ReplayData, time: float, length: float) -> slice:
     """Samples in (time - length, time]."""
     end = replay.index_at(time) + 1
-    start = int(np.searchsorted(replay.time, time - length, side="right"))
+    start = int(np.searchsorted(replay.time, time - length + 1e-9, side="right"))
     return slice(min(start, end - 1), end)
 
 
