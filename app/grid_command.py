@@ -9,6 +9,12 @@ from pathlib import Path
 
 from .overrides import add_robot_argument, add_set_argument
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
+from .replay_keep import (
+    add_replays_argument,
+    format_replays,
+    worst_grid_runs,
+    write_worst_replays,
+)
 from .robot_setup import check_robot_overrides
 from .sweep import SWEEP_CONTROLLERS
 
@@ -23,6 +29,7 @@ outputs in --out:
   grid.json   the specification, counts per controller, phase and impulse, every run
   grid.csv    one row per run: controller, phase, direction, impulse, outcome, ...
   grid.png    outcome per impulse and direction, one panel per controller and phase
+  replays/*/  the worst failed runs per controller: rsg replay FOLDER
 """
 
 
@@ -77,6 +84,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
     add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip grid.png")
+    add_replays_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -100,8 +108,12 @@ def grid_command(args: argparse.Namespace) -> int:
     workers = args.workers if args.workers is not None else os.cpu_count() or 1
     started = time.perf_counter()
     records = run_grid(spec, workers, progress=not args.quiet)
+    worst = worst_grid_runs(records, args.replays)
+    if worst and not args.quiet:
+        print(f"grid: simulating the {len(worst)} worst failed runs again to replay them ...")
+    replays = write_worst_replays(spec, worst, args.out)
     wall_time = time.perf_counter() - started
-    paths = write_grid(args.out, spec, records, wall_time)
+    paths = write_grid(args.out, spec, records, wall_time, replays)
     if not args.no_plots:
         from .grid_plot import plot_grid
 
@@ -109,5 +121,6 @@ def grid_command(args: argparse.Namespace) -> int:
     for path in paths:
         print(f"wrote {path}")
     print(format_grid(spec, records))
+    print(format_replays(replays))
     print(f"grid: {len(records)} runs, {wall_time:.0f} s wall time")
     return 0

@@ -11,6 +11,12 @@ from planner.parameters import CONTROLLERS
 
 from .envelope import build_envelope, format_table, write_envelope
 from .overrides import add_robot_argument, add_set_argument
+from .replay_keep import (
+    add_replays_argument,
+    format_replays,
+    worst_sweep_runs,
+    write_worst_replays,
+)
 from .robot_setup import check_robot_overrides
 from .sweep import PLACO_WPG, SweepSpec, run_sweep
 from .sweep_plot import plot_envelope
@@ -27,6 +33,7 @@ outputs in --out:
                                direction and phase
   envelope.png                 polar plot, one panel per phase
   jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes
+  replays/*/                   the worst failed runs per controller: rsg replay FOLDER
 """
 
 
@@ -84,6 +91,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
     add_set_argument(p)
+    add_replays_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -114,11 +122,16 @@ def sweep_command(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     records = run_sweep(spec, args.out, workers, args.backend, progress=not args.quiet)
     envelope = build_envelope(spec, records)
+    worst = worst_sweep_runs(records, args.replays)
+    if worst and not args.quiet:
+        print(f"sweep: simulating the {len(worst)} worst failed runs again to replay them ...")
+    envelope["replays"] = write_worst_replays(spec, worst, args.out)
     envelope["wall_time"] = time.perf_counter() - started
     paths = write_envelope(args.out, envelope)
     paths.append(plot_envelope(envelope, args.out / "envelope.png"))
     for path in paths:
         print(f"wrote {path}")
     print(format_table(envelope))
+    print(format_replays(envelope["replays"]))
     print(f"sweep: {len(records)} jobs, {envelope['wall_time']:.0f} s wall time")
     return 0
