@@ -17,6 +17,7 @@ changes the push; the push arrow shows while a push acts.
 
 from __future__ import annotations
 
+import html
 import threading
 import time as wallclock
 from collections.abc import Callable
@@ -61,6 +62,15 @@ SLOW_MOTION_LABELS = {
 def _set_value(handle: Any, value: object) -> None:
     """Set a GUI input's value (viser's setter, which mypy sees as read-only)."""
     handle.value = value
+
+
+def _note_html(text: str, refused: bool = False) -> str:
+    """The note under Push: two lines of fixed height (the panel below does not move)."""
+    colour = "#c0392b" if refused else "#555555"
+    return (
+        f'<div style="height:2.6em;line-height:1.3em;overflow:hidden;font-size:0.8em;'
+        f'color:{colour}">{html.escape(text)}</div>'
+    )
 
 
 @dataclass
@@ -162,9 +172,7 @@ class DemoPage:
                 ),
             }
             self.push_button = gui.add_button("Push", color="red")
-            self.push_note = gui.add_markdown(
-                "<small>Click the ground to aim from the robot.</small>"
-            )
+            self.push_note = gui.add_html(_note_html("Click the ground to aim from the robot."))
         with gui.add_folder("Simulation"):
             self.slow_motion = gui.add_dropdown(
                 "Slow motion",
@@ -223,8 +231,7 @@ class DemoPage:
 
     def _say(self, text: str, refused: bool = False) -> None:
         self._note = text
-        colour = "#c0392b" if refused else "#555555"
-        self.push_note.content = f'<small><span style="color:{colour}">{text}</span></small>'
+        self.push_note.content = _note_html(text, refused)
 
     def _push(self) -> None:
         refused = self._settle_fields()
@@ -312,7 +319,7 @@ class DemoPage:
                 try:
                     self.update(snap, start - last)
                 except Exception as exc:  # noqa: BLE001 - keep the page alive, say why
-                    self.view.status.content = f"page update failed: {exc!r}"
+                    self.view.set_status([f"page update failed: {html.escape(repr(exc))}"])
                 last = start
                 self._frames = [t for t in self._frames if t > start - 1.0] + [start]
                 self.update_rate = float(len(self._frames))
@@ -330,29 +337,28 @@ class DemoPage:
     def _update_status(self, snap: Snapshot) -> None:
         s = snap.status
         if s.error:
-            state = f"**stopped**: {s.error}. Press Reset."
+            state = f"<b>stopped</b>: {html.escape(s.error)}. Press Reset."
         elif s.busy:
-            state = f"**{s.busy} ...**"
+            state = f"<b>{s.busy} ...</b>"
         elif s.fell:
-            state = "**FALLEN**"
+            state = (
+                f'<b style="color:#c0392b">FALLEN</b> ({html.escape(s.fall_reason)}): press Reset'
+            )
         elif s.paused:
-            state = "**paused**"
+            state = "<b>paused</b>"
         else:
             state = "running"
-        self.view.status.content = (
-            f"**t = {s.time:.2f} s** · {state} · controller **{s.controller}** · "
-            f"{s.model} {s.robot if s.model != 'lipm' else ''}  \n"
-            f"speed {s.speed:.2f}x real time (asked {s.slow_motion:g}x) · "
-            f"page {self.update_rate:.0f} Hz · pushes {snap.pushes_applied} · "
-            f"adjusted steps {snap.adjusted_steps}  \n"
-            f"<small>last event: {s.last_event or '-'}</small>"
+        robot = s.robot if s.model != "lipm" else ""
+        self.view.set_status(
+            [
+                f"<b>t = {s.time:.2f} s</b> · {state} · controller <b>{s.controller}</b> · "
+                f"{s.model} {robot}",
+                f"speed {s.speed:.2f}x real time (asked {s.slow_motion:g}x) · "
+                f"page {self.update_rate:.0f} Hz",
+                f"pushes {snap.pushes_applied} · adjusted steps {snap.adjusted_steps}",
+                f"<small>last event: {html.escape(s.last_event or '-')}</small>",
+            ]
         )
-        self.view.alert.visible = s.fell
-        if s.fell:
-            self.view.alert.content = (
-                f"### The robot has fallen\n{s.fall_reason} at t = {s.time:.2f} s. "
-                "Press **Reset** to stand it up and restart."
-            )
         self.pause_button.label = "Resume" if s.paused else "Pause"
         if self.push_button.disabled == s.advancing:
             self.push_button.disabled = not s.advancing

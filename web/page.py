@@ -56,6 +56,7 @@ from .snapshot import Snapshot
 
 Array = NDArray[np.float64]
 
+STATUS_LINES = 4  # the status block's height [lines]
 PLOT_RATE = 5.0  # [Hz] uPlot updates
 IMAGE_RATE = 3.0  # [Hz] DCM-error plot updates (a matplotlib image, ~20 ms each)
 GRID_SIZE = 20.0  # [m]
@@ -112,6 +113,15 @@ LEGEND = (
 )
 
 
+def _status_html(lines: list[str]) -> str:
+    rows = "".join(
+        f'<div style="white-space:nowrap;overflow:hidden;text-overflow:ellipsis">{line}</div>'
+        for line in lines[:STATUS_LINES]
+    )
+    height = 1.45 * STATUS_LINES
+    return f'<div style="height:{height}em;line-height:1.45em;font-size:0.85em">{rows}</div>'
+
+
 def _colours(colour: Colour, count: int) -> NDArray[np.uint8]:
     return np.tile(np.array(colour, dtype=np.uint8), (count, 2, 1))
 
@@ -143,8 +153,7 @@ class PageView:
         server.initial_camera.position = (-0.7, -2.1, 1.25)
         server.initial_camera.look_at = (0.3, -0.45, 0.4)
         gui = server.gui
-        self.status = gui.add_markdown("starting ...")
-        self.alert = gui.add_markdown("", visible=False)
+        self.status = gui.add_html(_status_html(["starting ..."]))
         gui.add_html(LEGEND)
         if controls is not None:
             controls()
@@ -190,7 +199,12 @@ class PageView:
         scene = self.server.scene
         self.world = scene.add_frame("/world", show_axes=False)
         self.grid = scene.add_grid(
-            "/world/grid", GRID_SIZE, GRID_SIZE, cell_size=GRID_CELL, section_size=1.0
+            "/world/grid",
+            GRID_SIZE,
+            GRID_SIZE,
+            cell_size=GRID_CELL,
+            section_size=1.0,
+            shadow_opacity=0.0,
         )
         self.robot: RobotView | None = None
         if urdf is not None:
@@ -242,6 +256,11 @@ class PageView:
         self.fall_label = scene.add_label(
             "/world/fall_label", "", visible=False, font_screen_scale=1.6, anchor="bottom-center"
         )
+
+    def set_status(self, lines: list[str]) -> None:
+        """Show the status: up to :data:`STATUS_LINES` lines of HTML, each cut to one
+        line, in a block of fixed height (the controls below it never move)."""
+        self.status.content = _status_html(lines)
 
     @staticmethod
     def _lyapunov_scales(top: float) -> Any:

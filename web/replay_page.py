@@ -8,6 +8,7 @@ Playback stops at the end of the run; Play there starts it again from 0.
 
 from __future__ import annotations
 
+import html
 import threading
 import time as wallclock
 from pathlib import Path
@@ -128,12 +129,15 @@ class ReplayPage:
             else f"no fall in {meta['sim_time']:.2f} s"
         )
         state = "playing" if self.playing else "paused"
-        self.view.status.content = (
-            f"**replay** of `{self.folder}`  \n"
-            f"**t = {snap.status.time:.2f} s** of {self.replay.duration:.2f} · {state} "
-            f"({self._speed:g}x) · controller **{meta['controller']}** · {meta['model']} "
-            f"{meta['robot']} · scenario {meta['scenario']}  \n"
-            f"pushes {snap.pushes_applied} of {len(self.replay.pushes)} · adjusted steps "
-            f"{snap.adjusted_steps} · {outcome}"
+        self.view.set_status(
+            [
+                f"<b>replay</b> of <code>{html.escape(str(self.folder))}</code>",
+                f"<b>t = {snap.status.time:.2f} s</b> of {self.replay.duration:.2f} · {state} "
+                f"({self._speed:g}x)",
+                f"controller <b>{meta['controller']}</b> · {meta['model']} {meta['robot']} · "
+                f"scenario {html.escape(meta['scenario'])}",
+                f"pushes {snap.pushes_applied} of {len(self.replay.pushes)} · adjusted steps "
+                f"{snap.adjusted_steps} · {html.escape(outcome)}",
+            ]
         )
         self.view.show(snap, dt)

@@ -156,6 +156,8 @@ class RobotView:
                     np.asarray(mesh.vertices, np.float32),
                     np.asarray(mesh.faces, np.uint32),
                     color=_colour_of(visual, materials),
+                    cast_shadow=False,
+                    receive_shadow=False,
                 )
         order = {joint.name: index for index, joint in enumerate(robot.joints)}
         moving.sort(key=lambda joint: order[joint.name])
