@@ -173,7 +173,7 @@ class DemoPage:
             }
             self.push_button = gui.add_button("Push", color="red")
             self.push_note = gui.add_html(_note_html("Click the ground to aim from the robot."))
-        with gui.add_folder("Simulation"):
+        with gui.add_folder("Simulation", expand_by_default=False):
             self.slow_motion = gui.add_dropdown(
                 "Slow motion",
                 tuple(SLOW_MOTION_LABELS),

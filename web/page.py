@@ -153,6 +153,8 @@ class PageView:
         server.initial_camera.position = (-0.7, -2.1, 1.25)
         server.initial_camera.look_at = (0.3, -0.45, 0.4)
         gui = server.gui
+        # A wider panel: the legend and the plots fit, no share button (local pages).
+        gui.configure_theme(control_width="large", show_share_button=False)
         self.status = gui.add_html(_status_html(["starting ..."]))
         gui.add_html(LEGEND)
         if controls is not None:
