@@ -220,7 +220,7 @@ class ReplayData:
 
     def index_at(self, time: float) -> int:
         """Index of the last sample at or before ``time`` [s] (the first before the start)."""
-        index = int(np.searchsorted(self.time, time, side="right")) - 1
+        index = int(np.searchsorted(self.time, time + 1e-9, side="right")) - 1  # float times
         return min(max(index, 0), len(self.time) - 1)
 
     def impulse_at(self, time: float) -> np.ndarray | None:

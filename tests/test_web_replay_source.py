@@ -57,6 +57,8 @@ def test_snapshot_holds_the_recorded_state_at_that_time(replay):
     assert later.state is not None and len(later.state.steps) == len(taken)
     assert later.adjusted_steps == int(taken[:, 4].sum()) >= 1
     np.testing.assert_allclose(later.state.steps[-1].position, taken[-1, 2:4])
+    for time in (4.35, 7.77, 10.01):  # sample times are sums of float periods
+        assert snapshot_at(replay, time).state.time == pytest.approx(time)
     assert snapshot_at(replay, -5.0).state.time == 0.0  # clipped to the recording
     assert snapshot_at(replay, 99.0).state.time == pytest.approx(replay.duration)
 

@@ -112,6 +112,7 @@ class ReplayPage:
                 if self.time >= self.replay.duration:
                     self.playing = False
                     self.play_button.label = "Play"
+                    self._dirty = True  # draw the end once more, paused
                 _set_value(self.time_slider, round(self.time, 2))
             if self.playing or self._dirty:
                 self._dirty = False
@@ -131,7 +132,8 @@ class ReplayPage:
         state = "playing" if self.playing else "paused"
         self.view.set_status(
             [
-                f"<b>replay</b> of <code>{html.escape(str(self.folder))}</code>",
+                f'<b>replay</b> of <code title="{html.escape(str(self.folder.resolve()))}">'
+                f"{html.escape(self.folder.name)}</code>",
                 f"<b>t = {snap.status.time:.2f} s</b> of {self.replay.duration:.2f} · {state} "
                 f"({self._speed:g}x)",
                 f"controller <b>{meta['controller']}</b> · {meta['model']} {meta['robot']} · "
