@@ -83,8 +83,8 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         "--frame-rate",
         type=_frame_rate,
         default=40.0,
-        help="scene updates sent to the page per second, 1 to 60 (default: 40); lower it for "
-        "browsers without GPU rendering, which otherwise fall behind and answer clicks late",
+        help="scene updates sent to the page per second, 1 to 60 (default: 40); a browser "
+        "without GPU rendering draws fewer and answers a click within one of its frames",
     )
     return demo
 
