@@ -36,6 +36,7 @@ outputs in --out (a folder with an earlier run's results is refused without --ov
   summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
+  replay.npz       the run for the browser: rsg replay FOLDER
 
 exit code: 0 recovered, 1 not recovered, 2 bad input, 130 interrupted (Ctrl-C: what was
 simulated is written, summary.json says "interrupted": true)

@@ -9,6 +9,12 @@ import time
 from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
 from .result_folder import add_out_arguments, prepare_out
+from .replay_keep import (
+    add_replays_argument,
+    format_replays,
+    worst_grid_runs,
+    write_worst_replays,
+)
 from .robot_setup import check_robot_overrides
 from .setup import PAPER_RULES_HELP
 from .sweep import SWEEP_CONTROLLERS, check_workers
@@ -24,6 +30,7 @@ outputs in --out:
   grid.json   the specification, counts per controller, phase and impulse, every run
   grid.csv    one row per run: controller, phase, direction, impulse, outcome, ...
   grid.png    outcome per impulse and direction, one panel per controller and phase
+  replays/*/  the worst failed runs per controller: rsg replay FOLDER
 """
 
 
@@ -80,6 +87,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
     add_out_arguments(p)
     add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip grid.png")
+    add_replays_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -106,8 +114,12 @@ def grid_command(args: argparse.Namespace) -> int:
         print(f"deleted {path} (--overwrite)")
     started = time.perf_counter()
     records = run_grid(spec, workers, progress=not args.quiet)
+    worst = worst_grid_runs(records, args.replays)
+    if worst and not args.quiet:
+        print(f"grid: simulating the {len(worst)} worst failed runs again to replay them ...")
+    replays = write_worst_replays(spec, worst, args.out)
     wall_time = time.perf_counter() - started
-    paths = write_grid(args.out, spec, records, wall_time)
+    paths = write_grid(args.out, spec, records, wall_time, replays)
     if not args.no_plots:
         from .grid_plot import plot_grid
 
@@ -115,5 +127,6 @@ def grid_command(args: argparse.Namespace) -> int:
     for path in paths:
         print(f"wrote {path}")
     print(format_grid(spec, records))
+    print(format_replays(replays))
     print(f"grid: {len(records)} runs, {wall_time:.0f} s wall time")
     return 0

@@ -212,8 +212,15 @@ def _counts(rows: list[dict]) -> dict[str, int]:
     return counts
 
 
-def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float) -> list[Path]:
-    """``grid.json`` (spec, summary, records) and ``grid.csv`` (one row per run)."""
+def write_grid(
+    out: Path,
+    spec: GridSpec,
+    records: list[dict],
+    wall_time: float,
+    replays: list[dict] | None = None,
+) -> list[Path]:
+    """``grid.json`` (spec, summary, records, replays of the worst runs) and ``grid.csv``
+    (one row per run)."""
     try:
         out.mkdir(parents=True, exist_ok=True)
         document = {
@@ -231,6 +238,7 @@ def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float)
             },
             "summary": summarize(spec, records),
             "records": records,
+            "replays": replays or [],
             "wall_time": wall_time,
         }
         json_path = out / "grid.json"

@@ -11,6 +11,12 @@ from planner.parameters import CONTROLLERS
 from .envelope import build_envelope, format_table, write_envelope
 from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .result_folder import add_out_arguments
+from .replay_keep import (
+    add_replays_argument,
+    format_replays,
+    worst_sweep_runs,
+    write_worst_replays,
+)
 from .robot_setup import check_robot_overrides
 from .setup import PAPER_RULES_HELP
 from .sweep import PLACO_WPG, SweepSpec, check_workers, run_sweep
@@ -29,6 +35,7 @@ outputs in --out:
   envelope.png                 polar plot, one panel per phase
   jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes (the same
                                settings; --overwrite starts over)
+  replays/*/                   the worst failed runs per controller: rsg replay FOLDER
 """
 
 
@@ -91,6 +98,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
     add_out_arguments(p, "the results (a sweep's folder is resumed)")
     add_set_argument(p)
+    add_replays_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -124,11 +132,16 @@ def sweep_command(args: argparse.Namespace) -> int:
         spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite
     )
     envelope = build_envelope(spec, records)
+    worst = worst_sweep_runs(records, args.replays)
+    if worst and not args.quiet:
+        print(f"sweep: simulating the {len(worst)} worst failed runs again to replay them ...")
+    envelope["replays"] = write_worst_replays(spec, worst, args.out)
     envelope["wall_time"] = time.perf_counter() - started
     paths = write_envelope(args.out, envelope)
     paths.append(plot_envelope(envelope, args.out / "envelope.png"))
     for path in paths:
         print(f"wrote {path}")
     print(format_table(envelope))
+    print(format_replays(envelope["replays"]))
     print(f"sweep: {len(records)} jobs, {envelope['wall_time']:.0f} s wall time")
     return 0
