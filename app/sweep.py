@@ -26,11 +26,11 @@ import json
 import math
 import sys
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Protocol, TypeVar
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
@@ -267,6 +267,7 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
         "capped": found.failed is None,
         "bound": bound,
         "ratio": found.passed / bound if bound > 0 else math.nan,
+        "mass": config.model.mass,
         "runs": len(found.evaluations),
         "evaluations": found.evaluations,
         "wall_time": time.perf_counter() - started,
@@ -314,25 +315,31 @@ class JobProgress:
         sys.stderr.flush()
 
 
-def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
+def load_finished(
+    out: Path, spec: Any, spec_file: str = SPEC_FILE, fields: tuple[str, ...] = RESULT_FIELDS
+) -> dict[str, dict]:
     """Jobs already finished in ``out`` (resume); checks the spec agrees.
 
+    Args:
+        spec: A frozen dataclass with defaults (:class:`SweepSpec`, or another
+            command's), stored in ``out / spec_file``; ``fields`` are those that
+            change a job's result.
+
     Raises:
-        ParameterError: The folder holds a sweep with other result-defining settings.
+        ParameterError: The folder holds a run with other result-defining settings.
     """
-    spec_path = out / SPEC_FILE
+    spec_path = out / spec_file
     if spec_path.is_file():
         old = json.loads(spec_path.read_text())
         # Tuples as JSON lists, as stored.
-        new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, SweepSpec()))
-        for name in RESULT_FIELDS:  # a field missing from an older spec had its default
+        new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, type(spec)()))
+        for name in fields:  # a field missing from an older spec had its default
             stored = old.get(name, defaults[name])
             if stored != new[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",
                     asdict(spec)[name],
-                    f"the same {name} as the sweep stored there ({stored!r}), "
-                    "or a new --out folder",
+                    f"the same {name} as the run stored there ({stored!r}), or a new --out folder",
                 )
     finished: dict[str, dict] = {}
     jobs_path = out / JOBS_FILE
@@ -361,8 +368,40 @@ def run_sweep(
     workers: int = 1,
     backend: str = "process",
     progress: bool = True,
+    jobs: list[Job] | None = None,
 ) -> list[dict]:
-    """Run (or resume) the sweep into ``out``; returns the records of all its jobs.
+    """Run (or resume) the sweep into ``out``; returns the records of all its jobs
+    (``jobs``, default :func:`all_jobs`).
+
+    Raises:
+        ParameterError: Bad workers/backend or a mismatching folder.
+        RsgError: The folder cannot be written.
+    """
+    jobs = all_jobs(spec) if jobs is None else jobs
+    arguments = {job.key: (spec, job) for job in jobs}
+    finished = run_resumable(
+        _run_job_args, arguments, out, spec, RESULT_FIELDS, SPEC_FILE, workers, backend, progress
+    )
+    return [finished[job.key] for job in jobs]
+
+
+def run_resumable(
+    function: Callable[[T], dict],
+    arguments: dict[str, T],
+    out: Path,
+    spec: Any,
+    fields: tuple[str, ...],
+    spec_file: str,
+    workers: int,
+    backend: str,
+    progress: bool,
+    label: str = "sweep",
+) -> dict[str, dict]:
+    """The records of ``function`` over ``arguments`` (key -> argument; each record
+    carries its ``key``), run in ``workers`` or taken from ``out``'s ``jobs.jsonl``:
+    each new record is appended there as soon as it is done, and ``spec`` is stored in
+    ``spec_file`` (:func:`load_finished` checks ``fields`` on a resume). ``progress``:
+    a bar labelled ``label`` on stderr.
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
@@ -374,32 +413,35 @@ def run_sweep(
         raise ParameterError("--backend", backend, "process or ray")
     try:
         out.mkdir(parents=True, exist_ok=True)
-        finished = load_finished(out, spec)
-        (out / SPEC_FILE).write_text(json.dumps(asdict(spec), indent=2) + "\n")
+        finished = load_finished(out, spec, spec_file, fields)
+        (out / spec_file).write_text(json.dumps(asdict(spec), indent=2) + "\n")
     except OSError as exc:
-        raise RsgError(f"cannot write the sweep to {out}: {exc}") from exc
-    jobs = all_jobs(spec)
-    todo = [job for job in jobs if job.key not in finished]
-    bar = JobProgress(len(jobs), len(jobs) - len(todo), progress)
+        raise RsgError(f"cannot write the results to {out}: {exc}") from exc
+    todo = [argument for key, argument in arguments.items() if key not in finished]
+    bar = JobProgress(len(arguments), len(arguments) - len(todo), progress, label)
     with (out / JOBS_FILE).open("a") as sink:
-        for record in _execute(spec, todo, workers, backend):
+        for _, record in run_jobs(function, todo, workers, backend):
             sink.write(json.dumps(record) + "\n")
             sink.flush()
             finished[record["key"]] = record
             bar.advance()
-    return [finished[job.key] for job in jobs]
+    return finished
 
 
-def _execute(spec: SweepSpec, jobs: list[Job], workers: int, backend: str) -> Iterable[dict]:
-    if not jobs:
+def run_jobs(
+    function: Callable[[T], R], arguments: list[T], workers: int, backend: str = "process"
+) -> Iterator[tuple[T, R]]:
+    """(argument, result) of ``function`` for each argument, in the order they finish,
+    in worker processes (:func:`run_in_processes`) or as Ray tasks (``backend="ray"``,
+    :func:`app.sweep_ray.run_on_ray`)."""
+    if not arguments:
         return
     if backend == "ray":
-        from .sweep_ray import execute_on_ray
+        from .sweep_ray import run_on_ray
 
-        yield from execute_on_ray(spec, jobs, workers)
+        yield from run_on_ray(function, arguments, workers)
         return
-    for _, record in run_in_processes(_run_job_args, [(spec, job) for job in jobs], workers):
-        yield record
+    yield from run_in_processes(function, arguments, workers)
 
 
 def run_in_processes(
