@@ -369,9 +369,10 @@ def run_sweep(
     backend: str = "process",
     progress: bool = True,
     jobs: list[Job] | None = None,
+    label: str = "sweep",
 ) -> list[dict]:
     """Run (or resume) the sweep into ``out``; returns the records of all its jobs
-    (``jobs``, default :func:`all_jobs`).
+    (``jobs``, default :func:`all_jobs`; ``label`` names the progress bar).
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
@@ -380,7 +381,16 @@ def run_sweep(
     jobs = all_jobs(spec) if jobs is None else jobs
     arguments = {job.key: (spec, job) for job in jobs}
     finished = run_resumable(
-        _run_job_args, arguments, out, spec, RESULT_FIELDS, SPEC_FILE, workers, backend, progress
+        _run_job_args,
+        arguments,
+        out,
+        spec,
+        RESULT_FIELDS,
+        SPEC_FILE,
+        workers,
+        backend,
+        progress,
+        label,
     )
     return [finished[job.key] for job in jobs]
 
@@ -396,12 +406,13 @@ def run_resumable(
     backend: str,
     progress: bool,
     label: str = "sweep",
+    unit: str = "jobs",
 ) -> dict[str, dict]:
     """The records of ``function`` over ``arguments`` (key -> argument; each record
     carries its ``key``), run in ``workers`` or taken from ``out``'s ``jobs.jsonl``:
     each new record is appended there as soon as it is done, and ``spec`` is stored in
     ``spec_file`` (:func:`load_finished` checks ``fields`` on a resume). ``progress``:
-    a bar labelled ``label`` on stderr.
+    a bar labelled ``label`` counting ``unit`` on stderr.
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
@@ -418,7 +429,7 @@ def run_resumable(
     except OSError as exc:
         raise RsgError(f"cannot write the results to {out}: {exc}") from exc
     todo = [argument for key, argument in arguments.items() if key not in finished]
-    bar = JobProgress(len(arguments), len(arguments) - len(todo), progress, label)
+    bar = JobProgress(len(arguments), len(arguments) - len(todo), progress, label, unit)
     with (out / JOBS_FILE).open("a") as sink:
         for _, record in run_jobs(function, todo, workers, backend):
             sink.write(json.dumps(record) + "\n")

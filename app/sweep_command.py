@@ -21,12 +21,15 @@ examples:
   rsg sweep --model lipm --controllers rsg,no-step --phases 0.5 --directions 8 --out /tmp/s
   rsg sweep --model pybullet --controllers rsg,placo-wpg --directions 4 --phases 0.25 --out r
   rsg sweep --backend ray --workers 64 --out results/sweep   # on a Ray cluster (RAY_ADDRESS)
+  rsg sweep --model lipm --directions 8 --out results/sweep --monotonicity  # then 1/4, 1/2, 3/4
 
 outputs in --out:
   envelope.json, envelope.csv  largest recovered impulse and the bound per controller,
                                direction and phase
   envelope.png                 polar plot, one panel per phase
   jobs.jsonl, sweep_spec.json  finished jobs; running again on --out resumes
+  monotonicity.json            with --monotonicity: runs at 0.25, 0.5, 0.75 of each largest
+                               recovered impulse that fail the criterion (in monotonicity/)
 """
 
 
@@ -84,6 +87,12 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
     add_set_argument(p)
+    p.add_argument(
+        "--monotonicity",
+        action="store_true",
+        help="after the sweep, run each largest recovered impulse again at 0.25, 0.5 and "
+        "0.75 of it and count the runs that fail the criterion",
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -121,4 +130,10 @@ def sweep_command(args: argparse.Namespace) -> int:
         print(f"wrote {path}")
     print(format_table(envelope))
     print(f"sweep: {len(records)} jobs, {envelope['wall_time']:.0f} s wall time")
+    if args.monotonicity:
+        from .monotonicity import format_monotonicity, run_monotonicity, write_monotonicity
+
+        report = run_monotonicity(spec, records, args.out, workers, args.backend, not args.quiet)
+        print(f"wrote {write_monotonicity(args.out, report)}")
+        print(format_monotonicity(report))
     return 0
