@@ -103,17 +103,17 @@ def test_bad_campaigns_name_the_field(change: dict, field: str) -> None:
 
 def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     """A G1 campaign's twin run against ``rsg run --model lipm --robot g1 --push``."""
-    overrides = (("swing_preparation_time", "0.4"), ("cop_feedback", "0,2"))
+    overrides = (("swing_preparation_time", "0.5"), ("cop_feedback", "0,2"))
     spec = CampaignSpec(controllers=("rsg", "placo-wpg"), settle=4.0, overrides=overrides)
     twin = spec.twin()
     assert twin is not None and twin.model == "lipm" and twin.robot == "g1"
     assert twin.controllers == ("rsg",)  # placo-wpg has no LIPM twin
-    assert twin.overrides == (("swing_preparation_time", "0.4"),)  # no backend option
+    assert twin.overrides == (("swing_preparation_time", "0.5"),)  # no backend option
     push = CampaignPush(0, direction_deg=120.0, phase=0.6, time=3.58, impulse=9.0, duration=0.1)
     record = run_campaign_job(spec, push, CampaignJob(0, "rsg", twin=True))
     end = push.time + spec.settle
     code = main(["run", "--model", "lipm", "--robot", "g1", "--scenario", "walk",
-                 "--set", "swing_preparation_time=0.4", "--duration", f"{end}",
+                 "--set", "swing_preparation_time=0.5", "--duration", f"{end}",
                  "--push", push_argument(push), "--out", str(tmp_path), "--no-plots",
                  "--quiet"])  # fmt: skip
     direct = json.loads((tmp_path / "summary.json").read_text())
