@@ -207,7 +207,8 @@ class CampaignPush:
 
 
 def _floor(value: float, step: float) -> float:
-    return round(math.floor(value / step + 1e-9) * step, 9)
+    """``value`` floored to a multiple of ``step`` (so a draw below a range's end stays below)."""
+    return round(math.floor(value / step) * step, 9)
 
 
 def draw_pushes(spec: CampaignSpec, config: PlannerConfig | None = None) -> list[CampaignPush]:

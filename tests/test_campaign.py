@@ -73,6 +73,27 @@ def test_draws_are_reproducible_and_within_their_ranges(seed: int) -> None:
     assert [p.direction_deg for p in other] != [p.direction_deg for p in pushes]
 
 
+@pytest.mark.parametrize("unit", [0.0, 1.0 - 1e-12])
+def test_draws_at_the_ends_of_the_generator_stay_in_their_ranges(unit: float, monkeypatch) -> None:
+    """The generator's extreme outputs map onto the ends of each range, within it."""
+
+    class Extreme:
+        def __init__(self, seed: list[int]) -> None:
+            pass
+
+        def uniform(self, low: float, high: float, size: int) -> np.ndarray:
+            return np.full(size, low + (high - low) * unit)
+
+    monkeypatch.setattr(campaign_module.np.random, "default_rng", Extreme)
+    spec = CampaignSpec(model="lipm", robot="g1", pushes=1)
+    (push,) = draw_pushes(spec)
+    if unit == 0.0:
+        assert (push.direction_deg, push.phase, push.impulse, push.duration) == (0, 0, 5, 0.05)
+    else:
+        assert push.direction_deg == pytest.approx(359.9) and push.phase == pytest.approx(0.999)
+        assert push.impulse == pytest.approx(9.99) and push.duration == pytest.approx(0.199)
+
+
 def test_default_impulses_keep_the_velocity_change_of_g1() -> None:
     talos = CampaignSpec(model="lipm", robot="talos")
     scale = get_robot("talos").total_mass / REFERENCE_MASS
