@@ -21,8 +21,9 @@ support is [t_k, t_k + T_DSP), the swing [t_k + T_DSP, t_k + T^*). Forward (0 de
 backward (180 deg) and inward (90 deg) start at t_k + T_DSP + T_SSP / 2 (sweep phase
 (T_DSP + T_SSP / 2) / T^*, 0.5625 on G1), outward (270 deg) at t_k + T_DSP / 2
 (phase 0.0625), t_k nominal (on the paper's point mass the 1 kHz loop lands each step
-2 ms late, 7 ms by cycle 4; on the robots' planners on time). A force of f m g over 0.1 s is an impulse f m g 0.1 s and a velocity
-change f g 0.1 s (0.981 m/s per unit of f, whatever the mass).
+2 ms late, 7 ms by cycle 4; on the robots' planners on time). A force of f m g over
+0.1 s is an impulse f m g 0.1 s and a velocity change f g 0.1 s (0.981 m/s per unit of
+f, whatever the mass).
 
 Differences, said once: IHMC pushes the chest (0.3 m above its joint) and passes a test
 when the robot does not fall and its pelvis ends within a box around the end of its

@@ -85,7 +85,7 @@ class PushRun:
 
 def describe(result: RunResult, push: Push, controller: str) -> dict:
     """JSON-ready figures of a run after ``push``: outcome, fall reason, end time [s],
-    adjusted steps and steps to settle after the push start, largest V_u [-]."""
+    adjusted steps and steps to settle after the push start, largest and final V_u [-]."""
     defined = controller != PLACO_WPG  # placo-wpg reports V_u = 0: not defined
     return {
         "outcome": outcome_of(result),
@@ -94,6 +94,7 @@ def describe(result: RunResult, push: Push, controller: str) -> dict:
         "adjusted_steps": adjusted_steps_after(result, push.time),
         "settle_steps": settle_steps(result, push.time) if defined else None,
         "max_lyapunov": float(result.max_lyapunov) if defined else None,
+        "final_lyapunov": float(result.final_lyapunov) if defined else None,
     }
 
 

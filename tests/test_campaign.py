@@ -130,7 +130,9 @@ def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     assert twin is not None and twin.model == "lipm" and twin.robot == "g1"
     assert twin.controllers == ("rsg",)  # placo-wpg has no LIPM twin
     assert twin.overrides == (("swing_preparation_time", "0.5"),)  # no backend option
-    push = CampaignPush(0, direction_deg=120.0, phase=0.6, time=3.58, impulse=9.0, duration=0.1)
+    # Early in single support, so that T_SP gates the first step (it lands at 3.707 s,
+    # 3.607 s with G1's 0.4 s).
+    push = CampaignPush(0, direction_deg=300.0, phase=0.3, time=3.34, impulse=9.0, duration=0.1)
     record = run_campaign_job(spec, push, CampaignJob(0, "rsg", twin=True))
     end = push.time + spec.settle
     code = main(["run", "--model", "lipm", "--robot", "g1", "--scenario", "walk",
@@ -143,6 +145,7 @@ def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     assert record["adjusted_steps"] == direct["adjusted_steps"] >= 1
     assert record["end_time"] == pytest.approx(direct["sim_time"])
     assert record["max_lyapunov"] == pytest.approx(direct["max_lyapunov"], rel=1e-3)
+    assert record["final_lyapunov"] == pytest.approx(direct["final_lyapunov"], rel=1e-3)
 
 
 def test_interrupted_campaign_resumes_and_skips_finished_runs(tmp_path: Path, monkeypatch) -> None:
