@@ -244,6 +244,20 @@ def test_bad_command_input_is_refused(capsys) -> None:
         assert word in capsys.readouterr().err
 
 
+def test_ray_backend_gives_the_same_campaign(tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray", reason="ray is not installed (pip install 'rsg[ray]')")
+    ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
+    try:
+        _, on_ray = run_campaign(QUICK, tmp_path / "ray", workers=2, backend="ray", progress=False)
+    finally:
+        ray.shutdown()
+    _, local = run_campaign(QUICK, tmp_path / "local", workers=1, progress=False)
+    assert on_ray.keys() == local.keys()
+    for key, record in local.items():
+        for figure in ("outcome", "adjusted_steps", "settle_steps", "end_time", "final_lyapunov"):
+            assert on_ray[key][figure] == record[figure], (key, figure)
+
+
 @pytest.mark.slow
 def test_small_g1_campaign(tmp_path: Path) -> None:
     """Two pushes on G1 in PyBullet with rsg and their twins, in two workers."""
