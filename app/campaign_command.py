@@ -3,17 +3,16 @@
 from __future__ import annotations
 
 import argparse
-import os
 import time
-from pathlib import Path
 
 from planner.exceptions import RsgError
 
 from .campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
 from .campaign_report import format_summary, push_rows, summarize, write_campaign
-from .overrides import add_robot_argument, add_set_argument
+from .overrides import add_robot_argument
 from .robot_setup import check_robot_overrides
 from .sweep import SWEEP_CONTROLLERS
+from .sweep_command import add_job_options, csv_names, workers_of
 
 EPILOG = """\
 examples:
@@ -107,20 +106,8 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
         default=CampaignSpec.settle,
         help="simulated time after the push start [s] (default 8)",
     )
-    p.add_argument(
-        "--paper-rules", action="store_true", help="the RSG without the documented extensions"
-    )
-    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
-    p.add_argument(
-        "--backend",
-        choices=("process", "ray"),
-        default="process",
-        help="process (default) or ray (needs the 'ray' extra)",
-    )
-    p.add_argument("--out", type=Path, required=True, help="folder for the results")
-    add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip campaign.png")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_job_options(p)
 
 
 def campaign_command(args: argparse.Namespace) -> int:
@@ -128,7 +115,7 @@ def campaign_command(args: argparse.Namespace) -> int:
     spec = CampaignSpec(
         model=args.model,
         robot=args.robot,
-        controllers=tuple(c.strip() for c in args.controllers.split(",") if c.strip()),
+        controllers=csv_names(args.controllers),
         pushes=args.pushes,
         seed=args.seed,
         impulse=args.impulse,
@@ -140,7 +127,7 @@ def campaign_command(args: argparse.Namespace) -> int:
     )
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
-    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    workers = workers_of(args)
     started = time.perf_counter()
     pushes, records = run_campaign(spec, args.out, workers, args.backend, not args.quiet)
     wall_time = time.perf_counter() - started

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import argparse
-import os
 import time
-from pathlib import Path
 
-from .overrides import add_robot_argument, add_set_argument
+from .overrides import add_robot_argument
 from .protocol import ProtocolSpec, format_protocol, run_protocol, write_protocol
 from .robot_setup import check_robot_overrides
 from .sweep import SWEEP_CONTROLLERS
+from .sweep_command import add_job_options, csv_names, workers_of
 
 EPILOG = """\
 examples:
@@ -58,17 +57,7 @@ def add_protocol_parser(sub: argparse._SubParsersAction) -> None:
         help="success: recovered (default) or no fall",
     )
     p.add_argument("--settle", type=float, default=8.0, help="time after the push [s] (8)")
-    p.add_argument("--paper-rules", action="store_true", help="the RSG without the extensions")
-    p.add_argument("--workers", type=int, default=None, help="parallel workers (CPU count)")
-    p.add_argument(
-        "--backend",
-        choices=("process", "ray"),
-        default="process",
-        help="process (default) or ray (needs the 'ray' extra)",
-    )
-    p.add_argument("--out", type=Path, required=True, help="folder for the results")
-    add_set_argument(p)
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_job_options(p)
 
 
 def protocol_command(args: argparse.Namespace) -> int:
@@ -76,7 +65,7 @@ def protocol_command(args: argparse.Namespace) -> int:
     spec = ProtocolSpec(
         model=args.model,
         robot=args.robot,
-        controllers=tuple(c.strip() for c in args.controllers.split(",") if c.strip()),
+        controllers=csv_names(args.controllers),
         settle=args.settle,
         tolerance=args.tolerance,
         criterion=args.criterion,
@@ -85,7 +74,7 @@ def protocol_command(args: argparse.Namespace) -> int:
     )
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
-    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    workers = workers_of(args)
     started = time.perf_counter()
     document = run_protocol(spec, args.out, workers, args.backend, progress=not args.quiet)
     document["wall_time"] = time.perf_counter() - started

@@ -33,13 +33,13 @@ outputs in --out:
 """
 
 
-def _csv(text: str) -> tuple[str, ...]:
+def csv_names(text: str) -> tuple[str, ...]:
     return tuple(part.strip() for part in text.split(",") if part.strip())
 
 
 def _phases(text: str) -> tuple[float, ...]:
     try:
-        return tuple(float(p) for p in _csv(text))
+        return tuple(float(p) for p in csv_names(text))
     except ValueError:
         raise argparse.ArgumentTypeError(f"--phases={text!r}: fractions like 0,0.25,0.5") from None
 
@@ -58,7 +58,7 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     add_robot_argument(p)
     p.add_argument(
         "--controllers",
-        type=_csv,
+        type=csv_names,
         default=None,
         help=f"comma-separated, of {', '.join((*CONTROLLERS, PLACO_WPG))} (default: all that "
         "fit the model; placo-wpg needs --model pybullet)",
@@ -77,6 +77,18 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--criterion", choices=("recovered", "no-fall"), default=None,
                    help="recovered (lipm default) or no-fall (pybullet default)")  # fmt: skip
     p.add_argument(
+        "--monotonicity",
+        action="store_true",
+        help="after the sweep, run each largest recovered impulse again at 0.25, 0.5 and "
+        "0.75 of it and count the runs that fail the criterion",
+    )
+    add_job_options(p)
+
+
+def add_job_options(p: argparse.ArgumentParser) -> None:
+    """The options of every command that runs jobs (``sweep``, ``pushes``, ``protocol``):
+    ``--paper-rules``, ``--workers``, ``--backend``, ``--out``, ``--set``, ``--quiet``."""
+    p.add_argument(
         "--paper-rules",
         action="store_true",
         help="the RSG without the documented extensions (push hold, leg reach in the "
@@ -87,13 +99,12 @@ def add_sweep_parser(sub: argparse._SubParsersAction) -> None:
                    help="process (default) or ray (needs the 'ray' extra)")  # fmt: skip
     p.add_argument("--out", type=Path, required=True, help="folder for the results")
     add_set_argument(p)
-    p.add_argument(
-        "--monotonicity",
-        action="store_true",
-        help="after the sweep, run each largest recovered impulse again at 0.25, 0.5 and "
-        "0.75 of it and count the runs that fail the criterion",
-    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def workers_of(args: argparse.Namespace) -> int:
+    """``--workers``, by default the CPU count."""
+    return args.workers if args.workers is not None else os.cpu_count() or 1
 
 
 def sweep_command(args: argparse.Namespace) -> int:
@@ -119,7 +130,7 @@ def sweep_command(args: argparse.Namespace) -> int:
     )
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
-    workers = args.workers if args.workers is not None else os.cpu_count() or 1
+    workers = workers_of(args)
     started = time.perf_counter()
     records = run_sweep(spec, args.out, workers, args.backend, progress=not args.quiet)
     envelope = build_envelope(spec, records)
