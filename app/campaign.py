@@ -14,7 +14,7 @@ the same seed. In this order, each floored to a grid so that it is written exact
   nominal steps after the start) on the left stance foot;
 * impulse uniform in ``impulse`` [N s], 0.01 N s; by default 5-10 N s on G1
   (33.3 kg) and the same velocity change on other robots: 5-10 N s times
-  m / 33.3 kg (Talos, 90.3 kg: 13.6-27.1 N s);
+  m / 33.3 kg (Talos, 90.27 kg: 13.55-27.11 N s);
 * duration uniform in ``duration`` [s], 1 ms (default 0.05-0.2 s).
 
 Seeds (:data:`SEEDS`): ``dev`` (1) is for development and tuning; ``eval`` (2) is for
