@@ -61,7 +61,6 @@ def test_steps_until_v_u_stays_below_gamma_v(runs: dict) -> None:
     time, level = result.column("t"), result.column("lyapunov")
     assert np.all(level[time >= last["t"]] < gamma)
     assert all(s["lyapunov_before"] < gamma for s in after[count:])
-    assert adjusted_steps_after(result, push.time) <= count
     assert adjusted_steps_after(result, push.time) >= 1
 
 
