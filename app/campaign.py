@@ -6,12 +6,15 @@ the order of the runs, and a campaign of N pushes is the first N of a longer one
 the same seed. In this order, each floored to a grid so that it is written exactly:
 
 * direction uniform in [0, 360) deg (0 forward, 90 to the left), 0.1 deg;
-* phase uniform in [0, 1), 0.001: the push starts at t = t_k + phase T^* of cycle k =
-  ``cycle``, t_k = T_SSP + (k - 1) T^* the nominal touchdown of step k, as the
-  sweep's phase (:func:`app.sweep_trial.push_timing`): the fraction of the cycle
-  since the last nominal touchdown; below T_DSP / T^* (0.125 on G1) the push starts
-  in double support. The default cycle 4 starts at 3.1 s on G1 and Talos (three
-  nominal steps after the start) on the left stance foot;
+* phase uniform in [0, 1), 0.001: the push starts ``phase`` T^* after the touchdown
+  of step k = ``cycle`` in the unpushed walk, measured once per model and controller
+  (:func:`app.sweep_trial.measured_touchdown`). So the phase is the fraction of the
+  gait cycle T^* since the last touchdown of the nominal walk, and a push hits the robot
+  and its twin at the same point of their gaits (the loop steps at the first tick in
+  the nominal jump set, so touchdowns drift from the nominal t_k = T_SSP + (k - 1) T^*:
+  step 4 at 3.17 s on G1 in PyBullet, 3.107 s on its twin, t_4 = 3.1 s). Below
+  T_DSP / T^* (0.125 on G1) the push starts in double support. The default cycle 4 is
+  three nominal steps after the start, on the left stance foot;
 * impulse uniform in ``impulse`` [N s], 0.01 N s; by default 5-10 N s on G1
   (33.3 kg) and the same velocity change on other robots: 5-10 N s times
   m / 33.3 kg (Talos, 90.27 kg: 13.55-27.11 N s);
@@ -23,7 +26,7 @@ reported figures only, never for choosing a parameter.
 The twin: each push also runs on the LIPM with the same robot's planner
 (``--model lipm --robot NAME``: its mass, sole, gait and timing on the point mass,
 the same controller, and the ``--set`` values that apply there), with the same push
-and end time: what the planner promises if the robot realised the LIPM. On
+and timing: what the planner promises if the robot realised the LIPM. On
 ``--model lipm`` the run is its own twin (no second run). placo-wpg has no twin.
 
 Jobs: one run per (push, controller, robot or twin), recorded in ``jobs.jsonl`` as
@@ -51,7 +54,6 @@ from .push_outcome import PushRun, describe, impulse_along
 from .scenarios import MAX_IMPULSE
 from .setup import build_backend, resolve_robot
 from .sweep import PLACO_WPG, check_pushes, run_resumable
-from .sweep_trial import push_timing
 
 SEEDS = {"dev": 1, "eval": 2}
 #: Mass [kg] the default impulse range is given for (G1's).
@@ -192,18 +194,20 @@ def gait_config(robot: str | None, paper_rules: bool, overrides: Overrides) -> P
 
 @dataclass(frozen=True)
 class CampaignPush:
-    """One drawn push: index, direction [deg], phase [-], start time [s], impulse [N s]
-    and duration [s]."""
+    """One drawn push: index, direction [deg], phase [-], delay after the touchdown
+    [s] (phase T^*), impulse [N s] and duration [s]."""
 
     index: int
     direction_deg: float
     phase: float
-    time: float
+    delay: float
     impulse: float
     duration: float
 
-    def push(self) -> Push:
-        return Push(self.time, impulse_along(self.direction_deg, self.impulse), self.duration)
+    def push(self, touchdown: float) -> Push:
+        """The push on a walk whose step ``cycle`` lands at ``touchdown`` [s]."""
+        vector = impulse_along(self.direction_deg, self.impulse)
+        return Push(round(touchdown + self.delay, 9), vector, self.duration)
 
 
 def _floor(value: float, step: float) -> float:
@@ -228,7 +232,7 @@ def draw_pushes(spec: CampaignSpec, config: PlannerConfig | None = None) -> list
                 index=index,
                 direction_deg=_floor(360.0 * direction, 0.1),
                 phase=phase,
-                time=round(push_timing(config, spec.cycle, phase)[0], 9),
+                delay=round(phase * config.gait.step_duration, 9),
                 impulse=min(_floor(low + (high - low) * unit_impulse, 0.01), high),
                 duration=min(duration, longest),
             )
@@ -243,6 +247,11 @@ class CampaignJob:
     index: int
     controller: str
     twin: bool = False
+
+    @property
+    def model_key(self) -> str:
+        """``robot|CONTROLLER`` or ``twin|CONTROLLER``."""
+        return f"{'twin' if self.twin else 'robot'}|{self.controller}"
 
     @property
     def key(self) -> str:
@@ -263,22 +272,41 @@ def campaign_jobs(spec: CampaignSpec) -> list[CampaignJob]:
     ]
 
 
-def run_campaign_job(spec: CampaignSpec, push: CampaignPush, job: CampaignJob) -> dict:
-    """One run; returns its JSON-ready record (what ``jobs.jsonl`` holds)."""
+def touchdowns(spec: CampaignSpec) -> dict[str, float]:
+    """Time [s] of the touchdown of step ``cycle`` in the unpushed walk, per model
+    (``robot``, ``twin``) and controller: ``"robot|rsg"`` -> 3.17 on G1."""
+    found = {}
+    for job in campaign_jobs(replace(spec, pushes=1)):
+        on = spec.twin() if job.twin else spec
+        if on is not None:
+            run = PushRun(on, job.controller)
+            found[job.model_key] = run.touchdown(spec.cycle)
+            run.backend.close()
+    return found
+
+
+def run_campaign_job(
+    spec: CampaignSpec, push: CampaignPush, job: CampaignJob, touchdown: float
+) -> dict:
+    """One run, the push ``push.delay`` after ``touchdown`` [s]; returns its JSON-ready
+    record (what ``jobs.jsonl`` holds)."""
     started = time.perf_counter()
     on = spec.twin() if job.twin else spec
     if on is None:
         raise ParameterError("twin", job.key, "a campaign with a twin (--model pybullet)")
-    result = PushRun(on, job.controller).run(push.push(), push.time + spec.settle)
+    pushed = push.push(touchdown)
+    result = PushRun(on, job.controller).run(pushed, pushed.time + spec.settle)
     return {
         "key": job.key,
         **asdict(job),
-        **describe(result, push.push(), job.controller),
+        "touchdown": touchdown,
+        "push_time": pushed.time,
+        **describe(result, pushed, job.controller),
         "wall_time": time.perf_counter() - started,
     }
 
 
-def _run_campaign_job_args(args: tuple[CampaignSpec, CampaignPush, CampaignJob]) -> dict:
+def _run_campaign_job_args(args: tuple[CampaignSpec, CampaignPush, CampaignJob, float]) -> dict:
     return run_campaign_job(*args)
 
 
@@ -294,10 +322,13 @@ def run_campaign(
 
     Raises:
         ParameterError: Bad workers/backend or a folder holding another campaign.
-        RsgError: The folder cannot be written.
+        RsgError: The folder cannot be written, or a walk does not reach the cycle.
     """
     pushes = draw_pushes(spec)
-    arguments = {job.key: (spec, pushes[job.index], job) for job in campaign_jobs(spec)}
+    times = touchdowns(spec)
+    arguments = {
+        job.key: (spec, pushes[job.index], job, times[job.model_key]) for job in campaign_jobs(spec)
+    }
     records = run_resumable(_run_campaign_job_args, arguments, out, spec, RESULT_FIELDS,
                             SPEC_FILE, workers, backend, progress, "pushes", "runs")  # fmt: skip
     return pushes, records

@@ -13,10 +13,12 @@ from planner.exceptions import RsgError
 from .campaign import CampaignJob, CampaignPush, CampaignSpec, seed_name
 from .push_outcome import OUTCOMES
 
-FIGURES = ("outcome", "fall_reason", "adjusted_steps", "settle_steps")
+FIGURES = ("push_time", "outcome", "fall_reason", "adjusted_steps", "settle_steps")
 DEFINITIONS = {
-    "phase": "fraction of the gait cycle T^* since the last nominal touchdown (push start "
-    "t = T_SSP + (cycle - 1) T^* + phase T^*; double support below T_DSP / T^*)",
+    "phase": "fraction of the gait cycle T^* since the touchdown of step `cycle` in the "
+    "unpushed walk (double support below T_DSP / T^*)",
+    "delay": "phase T^*: the push starts this long after that touchdown [s]",
+    "push_time": "start of the push in that run [s] (its model's touchdown + delay)",
     "velocity_change": "impulse / mass [m/s]",
     "recovered": "no fall, V_u < gamma_v at the end, the last two steps nominal",
     "survived": "no fall within settle after the push start, not recovered",
@@ -29,15 +31,16 @@ DEFINITIONS = {
 }
 
 
-def push_argument(push: CampaignPush) -> str:
-    """The push as ``rsg run --push T:IX,IY:D``."""
-    ix, iy = push.push().impulse
-    return f"{push.time:.4f}:{ix:.4f},{iy:.4f}:{push.duration:g}"
+def push_argument(push: CampaignPush, start: float) -> str:
+    """The push, starting at ``start`` [s], as ``rsg run --push T:IX,IY:D``."""
+    ix, iy = push.push(start - push.delay).impulse
+    return f"{start:.4f}:{ix:.4f},{iy:.4f}:{push.duration:g}"
 
 
 def push_rows(spec: CampaignSpec, pushes: list[CampaignPush], records: dict[str, dict]) -> list:
-    """One row per push: the draw, its velocity change and each controller's figures
-    on the robot (``runs``) and on the twin (``twins``; on the LIPM, the runs)."""
+    """One row per push: the draw, its velocity change, the ``rsg run --push`` argument
+    of the first controller's run and each controller's figures on the robot (``runs``)
+    and on the twin (``twins``; on the LIPM, the runs)."""
     twin = spec.twin()
     rows = []
     for push in pushes:
@@ -47,8 +50,9 @@ def push_rows(spec: CampaignSpec, pushes: list[CampaignPush], records: dict[str,
         else:
             names = twin.controllers if twin is not None else ()
             twins = {c: _figures(records, CampaignJob(push.index, c, twin=True)) for c in names}
+        first = runs[spec.controllers[0]]["push_time"]
         rows.append({**asdict(push), "velocity_change": round(push.impulse / spec.mass, 4),
-                     "push": push_argument(push), "runs": runs, "twins": twins})  # fmt: skip
+                     "push": push_argument(push, first), "runs": runs, "twins": twins})  # fmt: skip
     return rows
 
 
@@ -109,18 +113,19 @@ def write_campaign(
         "units": {
             "direction_deg": "deg",
             "phase": "-",
-            "time": "s",
+            "delay": "s",
+            "push_time": "s",
             "impulse": "N s",
             "duration": "s",
             "velocity_change": "m/s",
             "mass": "kg",
-        },  # fmt: skip
+        },
         "definitions": DEFINITIONS,
         "summary": summary,
         "pushes": rows,
         "wall_time": wall_time,
     }
-    push_columns = ("index", "direction_deg", "phase", "time", "impulse", "duration",
+    push_columns = ("index", "direction_deg", "phase", "delay", "impulse", "duration",
                     "velocity_change", "push")  # fmt: skip
     twin_names = list(rows[0]["twins"]) if rows else []
     header = [*push_columns]

@@ -16,14 +16,15 @@ mass x 9.81 N; single support starts when the swing foot's state becomes SWING),
   right foot, +y: away from the foot taking the weight (Atlas: 0.25).
 
 Here the same in the RSG's gait, cycle ``cycle`` (default 4: the left foot is the
-stance foot, as in IHMC's tests): step k lands at t_k = T_SSP + (k - 1) T^*, double
-support is [t_k, t_k + T_DSP), the swing [t_k + T_DSP, t_k + T^*). Forward (0 deg),
-backward (180 deg) and inward (90 deg) start at t_k + T_DSP + T_SSP / 2 (sweep phase
-(T_DSP + T_SSP / 2) / T^*, 0.5625 on G1), outward (270 deg) at t_k + T_DSP / 2
-(phase 0.0625), t_k nominal (on the paper's point mass the 1 kHz loop lands each step
-2 ms late, 7 ms by cycle 4; on the robots' planners on time). A force of f m g over
-0.1 s is an impulse f m g 0.1 s and a velocity change f g 0.1 s (0.981 m/s per unit of
-f, whatever the mass).
+stance foot, as in IHMC's tests), timed from the touchdown t_k of step k = ``cycle``
+measured in the unpushed walk of each controller and model, as IHMC's tests trigger on
+the gait state (:func:`app.sweep_trial.measured_touchdown`; on G1 in PyBullet t_4 is
+3.17 s, its nominal 3.1 s): double support is [t_k, t_k + T_DSP), the swing
+[t_k + T_DSP, t_k + T^*). Forward (0 deg), backward (180 deg) and inward (90 deg) start
+at t_k + T_DSP + T_SSP / 2 (sweep phase (T_DSP + T_SSP / 2) / T^*, 0.5625 on G1),
+outward (270 deg) at t_k + T_DSP / 2 (phase 0.0625). A force of f m g over 0.1 s is an
+impulse f m g 0.1 s and a velocity change f g 0.1 s (0.981 m/s per unit of f, whatever
+the mass).
 
 Differences, said once: IHMC pushes the chest (0.3 m above its joint) and passes a test
 when the robot does not fall and its pelvis ends within a box around the end of its
@@ -114,6 +115,7 @@ class ProtocolSpec:
             criterion=self.criterion,
             paper_rules=self.paper_rules,
             overrides=self.overrides,
+            timing="touchdown",
         )
 
 

@@ -25,6 +25,7 @@ from planner.types import Push
 from .runner import RunResult
 from .scenarios import Scenario
 from .sweep import PLACO_WPG, GridLike, build_controller
+from .sweep_trial import measured_touchdown
 
 OUTCOMES = ("recovered", "survived", "fell")
 
@@ -67,20 +68,35 @@ class PushRun:
     def __init__(self, spec: GridLike, controller: str) -> None:
         self.backend, self.config, self.initial, self.planner = build_controller(spec, controller)
 
+    def touchdown(self, cycle: int) -> float:
+        """Time [s] at which step ``cycle`` lands in the unpushed walk
+        (:func:`app.sweep_trial.measured_touchdown`); the backend stays open."""
+        try:
+            return measured_touchdown(self._runner(), self.backend, self.config, self.initial,
+                                      cycle, **self._options())  # fmt: skip
+        except BaseException:
+            self.backend.close()
+            raise
+
     def run(self, push: Push, end_time: float) -> RunResult:
         """Walk until ``end_time`` [s] with ``push`` (the QP (27) solved exactly; a fall
         ends the run early), then release the backend."""
-        from .runner import run_closed_loop
-
-        runner = getattr(self.backend, "run_closed_loop", None) or run_closed_loop
-        options = {} if self.planner is None else {"planner": self.planner}
         scenario = Scenario("push", end_time, (push,))
         try:
-            return runner(
-                self.backend, self.config, scenario, self.initial, qp_solver="exact", **options
-            )
+            return self._runner()(
+                self.backend, self.config, scenario, self.initial, qp_solver="exact",
+                **self._options(),
+            )  # fmt: skip
         finally:
             self.backend.close()
+
+    def _runner(self):  # noqa: ANN202
+        from .runner import run_closed_loop
+
+        return getattr(self.backend, "run_closed_loop", None) or run_closed_loop
+
+    def _options(self) -> dict:
+        return {} if self.planner is None else {"planner": self.planner}
 
 
 def describe(result: RunResult, push: Push, controller: str) -> dict:

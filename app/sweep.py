@@ -43,7 +43,7 @@ from .capturability import impulse_bound
 from .overrides import Overrides, parse_overrides
 from .scenarios import Scenario
 from .setup import DEFAULT_ROBOT, resolve_robot
-from .sweep_trial import SettledTrial, push_timing
+from .sweep_trial import SettledTrial, measured_touchdown, push_timing
 
 PLACO_WPG = "placo-wpg"
 T = TypeVar("T")
@@ -71,7 +71,7 @@ SPEC_FILE = "sweep_spec.json"
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
-                 "overrides")  # fmt: skip
+                 "overrides", "timing")  # fmt: skip
 
 
 def check_pushes(
@@ -137,6 +137,10 @@ class SweepSpec:
         paper_rules: The RSG without the documented extensions (push hold, leg
             reach in the QP, step reaction time; :func:`app.setup.paper_rules`).
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
+        timing: ``nominal``: the push starts at t_k + phase T^* with t_k the nominal
+            touchdown (:func:`app.sweep_trial.push_timing`); ``touchdown``: t_k is
+            the touchdown measured in the unpushed walk of each controller and model
+            (:func:`app.sweep_trial.measured_touchdown`; ``rsg protocol``).
     """
 
     model: str = "lipm"
@@ -154,12 +158,15 @@ class SweepSpec:
     fall_dcm_error: float = 2.0
     paper_rules: bool = False
     overrides: Overrides = ()
+    timing: str = "nominal"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
         check_pushes(
             self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
         )
+        if self.timing not in ("nominal", "touchdown"):
+            raise ParameterError("timing", self.timing, "nominal or touchdown")
         checks = {
             "duration": (self.duration, 1e-3, 1.0),
             "settle": (self.settle, 1.0, 60.0),
@@ -234,6 +241,9 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
     early = spec.model == "lipm" and spec.criterion == "recovered"
     try:
         t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
+        if spec.timing == "touchdown":
+            touchdown = measured_touchdown(runner, backend, config, initial, spec.cycle, **options)
+            t_push = touchdown + since
         bound = impulse_bound(config, job.angle, sigma, since, spec.duration)
         direction = np.array([math.cos(job.angle), math.sin(job.angle)])
         trial = None

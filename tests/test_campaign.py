@@ -23,9 +23,11 @@ from app.campaign import (
     parse_seed,
     run_campaign,
     run_campaign_job,
+    touchdowns,
 )
 from app.campaign_report import push_argument, push_rows, summarize
 from app.cli import main
+from app.push_outcome import PushRun
 from planner.exceptions import ParameterError
 from robots import get_robot
 
@@ -51,13 +53,11 @@ def test_draws_are_reproducible_and_within_their_ranges(seed: int) -> None:
     pushes = draw_pushes(spec, config)
     assert pushes == draw_pushes(spec, config)
     assert draw_pushes(replace(spec, pushes=20), config) == pushes[:20]  # a prefix
-    gait = config.gait
-    cycle_start = gait.single_support_duration + (spec.cycle - 1) * gait.step_duration
-    assert cycle_start == pytest.approx(3.1)
+    step_duration = config.gait.step_duration
     for push in pushes:
         assert 0.0 <= push.direction_deg < 360.0, push
         assert 0.0 <= push.phase < 1.0, push
-        assert push.time == pytest.approx(cycle_start + push.phase * gait.step_duration), push
+        assert push.delay == pytest.approx(push.phase * step_duration), push
         assert 5.0 <= push.impulse <= 10.0, push
         assert 0.05 <= push.duration <= 0.2, push
     # Uniform: every quarter of each range is drawn.
@@ -130,17 +130,20 @@ def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     assert twin is not None and twin.model == "lipm" and twin.robot == "g1"
     assert twin.controllers == ("rsg",)  # placo-wpg has no LIPM twin
     assert twin.overrides == (("swing_preparation_time", "0.5"),)  # no backend option
-    # Early in single support, so that T_SP gates the first step (it lands at 3.707 s,
-    # 3.607 s with G1's 0.4 s).
-    push = CampaignPush(0, direction_deg=300.0, phase=0.3, time=3.34, impulse=9.0, duration=0.1)
-    record = run_campaign_job(spec, push, CampaignJob(0, "rsg", twin=True))
-    end = push.time + spec.settle
+    # Early in single support, so that T_SP gates the first step (it lands 0.6 s after
+    # the touchdown, 0.5 s with G1's 0.4 s).
+    push = CampaignPush(0, direction_deg=300.0, phase=0.3, delay=0.24, impulse=9.0, duration=0.1)
+    touchdown = PushRun(twin, "rsg").touchdown(spec.cycle)
+    record = run_campaign_job(spec, push, CampaignJob(0, "rsg", twin=True), touchdown)
+    assert record["push_time"] == pytest.approx(touchdown + 0.24)
+    end = record["push_time"] + spec.settle
     code = main(["run", "--model", "lipm", "--robot", "g1", "--scenario", "walk",
                  "--set", "swing_preparation_time=0.5", "--duration", f"{end}",
-                 "--push", push_argument(push), "--out", str(tmp_path), "--no-plots",
-                 "--quiet"])  # fmt: skip
+                 "--push", push_argument(push, record["push_time"]), "--out", str(tmp_path),
+                 "--no-plots", "--quiet"])  # fmt: skip
     direct = json.loads((tmp_path / "summary.json").read_text())
     assert code == 0 and direct["recovered"]
+    assert direct["steps"][spec.cycle - 1]["t"] == pytest.approx(touchdown)  # step 4
     assert record["outcome"] == "recovered"
     assert record["adjusted_steps"] == direct["adjusted_steps"] >= 1
     assert record["end_time"] == pytest.approx(direct["sim_time"])
@@ -154,12 +157,12 @@ def test_interrupted_campaign_resumes_and_skips_finished_runs(tmp_path: Path, mo
     calls: list[str] = []
     interrupted: list[bool] = []
 
-    def counting(spec: CampaignSpec, push: CampaignPush, job: CampaignJob) -> dict:
+    def counting(spec: CampaignSpec, push: CampaignPush, job: CampaignJob, at: float) -> dict:
         calls.append(job.key)
         if len(calls) == 3 and not interrupted:  # once: Ctrl-C during the third run
             interrupted.append(True)
             raise KeyboardInterrupt
-        return real(spec, push, job)
+        return real(spec, push, job, at)
 
     monkeypatch.setattr(campaign_module, "run_campaign_job", counting)
     with pytest.raises(KeyboardInterrupt):
@@ -189,11 +192,12 @@ def test_outcomes_and_summary_of_a_lipm_campaign() -> None:
     spec = replace(QUICK, controllers=("rsg", "no-step"), pushes=6, settle=4.0,
                    impulse=(15.0, 24.0))  # fmt: skip
     pushes = draw_pushes(spec)
+    times = touchdowns(spec)
     records = {}
     for push in pushes:
         for controller in spec.controllers:
             job = CampaignJob(push.index, controller)
-            records[job.key] = run_campaign_job(spec, push, job)
+            records[job.key] = run_campaign_job(spec, push, job, times[job.model_key])
     rows = push_rows(spec, pushes, records)
     summary = summarize(spec, rows)
     rsg, no_step = summary["rsg"], summary["no-step"]
@@ -269,6 +273,9 @@ def test_small_g1_campaign(tmp_path: Path) -> None:
         run, twin = row["runs"]["rsg"], row["twins"]["rsg"]
         assert run["outcome"] in ("recovered", "survived", "fell"), row
         assert twin["outcome"] == "recovered", row  # 5-10 N s: the LIPM twin recovers
-        assert records[f"{row['index']}|rsg|robot"]["end_time"] <= row["time"] + spec.settle + 0.02
+        robot = records[f"{row['index']}|rsg|robot"]
+        assert robot["end_time"] <= robot["push_time"] + spec.settle + 0.02
+        assert run["push_time"] == pytest.approx(robot["touchdown"] + row["delay"])
+        assert twin["push_time"] - run["push_time"] == pytest.approx(3.107 - 3.17), row
     summary = summarize(spec, rows)["rsg"]
     assert summary["twin_recovered"] == 2

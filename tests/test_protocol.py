@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -15,52 +16,63 @@ from app.push_outcome import PushRun, impulse_along
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
 from app.setup import build_backend
-from app.sweep_trial import push_timing
+from app.sweep import run_job
 from planner.exceptions import ParameterError
 from planner.types import Push
 
 
-@pytest.mark.parametrize("robot", ["g1", "talos", None])
-def test_pushes_start_at_mid_swing_and_mid_double_support(robot: str | None) -> None:
-    """Forward, backward and inward at single-support start + half the swing, outward at
-    double-support start + half of it, on the left stance foot; checked on the run (on
-    the paper's point mass each step lands 2 ms after its nominal time, 7 ms by the
-    push; on the robots' planners on time)."""
-    spec = ProtocolSpec(model="lipm", robot=robot)
-    sweep = spec.sweep_spec()
-    backend, config, initial = build_backend("lipm", robot, "rsg")
-    gait = config.gait
-    touchdown = gait.single_support_duration + (spec.cycle - 1) * gait.step_duration
+def check_timing(spec: ProtocolSpec, tolerance: float) -> None:
+    """Run the inward and outward jobs of ``spec`` (a coarse bisection) and check, on a
+    run with a tiny push at each record's start, s~, the stance foot and the push's
+    side: inward at single-support start + half the swing towards the stance foot,
+    outward at double-support start + half of it away from it, left stance."""
+    sweep = replace(spec.sweep_spec(), tolerance=tolerance)
     jobs = protocol_jobs(sweep)
     assert [round(math.degrees(j.angle)) for j in jobs] == [0, 180, 90, 270]
-    for job, name in zip(jobs, DIRECTIONS, strict=True):
-        start, sigma, since = push_timing(config, sweep.cycle, job.phase)
-        in_transfer = name == "outward"
-        expected = gait.double_support_duration / 2 if in_transfer else (
-            gait.double_support_duration + gait.single_support_duration / 2
-        )  # fmt: skip
-        assert start == pytest.approx(touchdown + expected), name
-        assert sigma == 1, name  # left stance, as IHMC's right swing
-        # What the run shows at the push start: s~, the stance foot and the push's side.
-        push = Push(start, 0.01 * impulse_along(math.degrees(job.angle), 1.0), 0.1)
-        scenario = Scenario("protocol", start + 0.3, (push,))
+    assert jobs[0].phase == jobs[1].phase == jobs[2].phase != jobs[3].phase
+    backend, config, initial = build_backend(spec.model, spec.robot, "rsg")
+    gait = config.gait
+    expected = {
+        "inward": gait.double_support_duration + gait.single_support_duration / 2,
+        "outward": gait.double_support_duration / 2,
+    }
+    records = {name: run_job(sweep, jobs[i]) for i, name in ((2, "inward"), (3, "outward"))}
+    pushes = [
+        Push(records[n]["push_time"], 0.01 * impulse_along(records[n]["direction_deg"], 1.0), 0.1)
+        for n in ("inward", "outward")
+    ]
+    scenario = Scenario("protocol", records["inward"]["push_time"] + 0.3, tuple(pushes))
+    try:
         result = run_closed_loop(backend, config, scenario, initial, qp_solver="exact")
-        time = result.column("t")
+    finally:
+        backend.close()
+    time = result.column("t")
+    pushing = np.hypot(result.column("push_fx"), result.column("push_fy")) > 0.0
+    for name, record in records.items():
+        start = record["push_time"]
         tick = int(np.argmin(np.abs(time - start)))
-        late = 0.008 if robot is None else 0.0015
-        assert result.column("time_since_step")[tick] == pytest.approx(expected, abs=late)
-        assert (result.column("time_since_step")[tick] < gait.double_support_duration) == (
-            in_transfer
-        )  # fmt: skip
-        assert result.column("stance_sigma")[tick] == 1.0
+        since = result.column("time_since_step")[tick]
+        assert since == pytest.approx(expected[name], abs=1.5 * backend.control_period), name
+        assert (since < gait.double_support_duration) == (name == "outward"), name
+        assert result.column("stance_sigma")[tick] == 1.0, name
         towards_stance = result.column("foot_y")[tick] - result.column("com_y")[tick]
-        if name == "inward":
-            assert math.sin(job.angle) * towards_stance > 0.0
-        if name == "outward":
-            assert math.sin(job.angle) * towards_stance < 0.0
-        pushing = np.hypot(result.column("push_fx"), result.column("push_fy")) > 0.0
-        assert time[pushing].min() == pytest.approx(start, abs=0.0011)
-        assert time[pushing].max() == pytest.approx(start + 0.1, abs=0.0011)
+        lateral = math.sin(math.radians(record["direction_deg"]))
+        assert lateral * towards_stance * (1 if name == "inward" else -1) > 0.0, name
+        window = time[pushing & (np.abs(time - start - 0.05) < 0.1)]
+        assert window.min() == pytest.approx(start, abs=backend.control_period + 1e-6), name
+        assert window.max() == pytest.approx(start + 0.1, abs=backend.control_period + 1e-6)
+
+
+@pytest.mark.parametrize("robot", ["g1", None])
+def test_pushes_start_at_mid_swing_and_mid_double_support(robot: str | None) -> None:
+    """On the LIPM, where each step lands 2 ms after its nominal time (7 ms by the push)."""
+    check_timing(ProtocolSpec(model="lipm", robot=robot), tolerance=0.5)
+
+
+@pytest.mark.slow
+def test_pushes_start_at_mid_swing_and_mid_double_support_on_g1() -> None:
+    """On G1 in PyBullet, where step 4 lands 70 ms after its nominal time."""
+    check_timing(ProtocolSpec(model="pybullet"), tolerance=0.5)
 
 
 def test_bad_protocols_name_the_field() -> None:
