@@ -98,7 +98,7 @@ def add_campaign_parser(sub: argparse._SubParsersAction) -> None:
         "--cycle",
         type=int,
         default=CampaignSpec.cycle,
-        help="walking cycle of the push start (default 4: 3.1-3.9 s on G1)",
+        help="the push starts after the touchdown of this step (default 4: 3.17 s on G1)",
     )
     p.add_argument(
         "--settle",
