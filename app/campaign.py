@@ -105,7 +105,8 @@ class CampaignSpec:
         seed: Seed of the draws (:data:`SEEDS`).
         impulse: (low, high) impulse [N s]; ``None``: 5-10 N s times m / 33.3 kg.
         duration: (low, high) push duration [s].
-        cycle: Walking cycle (>= 1) over which the start time is drawn.
+        cycle: Step (>= 1) whose touchdown in the unpushed walk starts the gait cycle the
+            pushes are drawn over.
         settle: Simulated time after the push start [s].
         paper_rules: The RSG without the documented extensions.
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m] (the
