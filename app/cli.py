@@ -1,4 +1,5 @@
-"""The ``rsg`` command line: ``rsg run``, ``rsg sweep``, ``rsg grid``, ``rsg bench``, plug-ins.
+"""The ``rsg`` command line: ``rsg run``, ``sweep``, ``grid``, ``pushes``, ``protocol``, ``bench``,
+plug-ins.
 
 Packages that sit above ``app`` (the browser demo in ``web``) add their commands
 through the entry-point group ``rsg.commands`` (see pyproject.toml): each entry is a
@@ -145,11 +146,15 @@ def build_parser() -> argparse.ArgumentParser:
     for command in plugin_commands().values():
         command.add_parser(sub)
     from .bench import add_bench_parser
+    from .campaign_command import add_campaign_parser
     from .grid_command import add_grid_parser
+    from .protocol_command import add_protocol_parser
     from .sweep_command import add_sweep_parser
 
     add_sweep_parser(sub)
     add_grid_parser(sub)
+    add_campaign_parser(sub)
+    add_protocol_parser(sub)
     add_bench_parser(sub)
     return parser
 
@@ -174,6 +179,14 @@ def main(argv: list[str] | None = None) -> int:
             from .grid_command import grid_command
 
             return grid_command(args)
+        if args.command == "pushes":
+            from .campaign_command import campaign_command
+
+            return campaign_command(args)
+        if args.command == "protocol":
+            from .protocol_command import protocol_command
+
+            return protocol_command(args)
         if args.command == "bench":
             from .bench import bench_command
 

@@ -8,13 +8,13 @@ import time
 
 from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
-from .result_folder import add_out_arguments, prepare_out
 from .replay_keep import (
     add_replays_argument,
     format_replays,
     worst_grid_runs,
     write_worst_replays,
 )
+from .result_folder import add_out_arguments, prepare_out
 from .robot_setup import check_robot_overrides
 from .setup import PAPER_RULES_HELP
 from .sweep import SWEEP_CONTROLLERS, check_workers
@@ -79,8 +79,7 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
         default=GridSpec.settle,
         help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
     )
-    p.add_argument("--paper-rules", action="store_true",
-                   help=PAPER_RULES_HELP)
+    p.add_argument("--paper-rules", action="store_true", help=PAPER_RULES_HELP)
     p.add_argument("--workers", type=int, default=None,
                    help="parallel workers (default: the CPU count; at most 4 per CPU, and "
                    "never more than there are runs)")  # fmt: skip

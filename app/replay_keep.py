@@ -75,9 +75,7 @@ def format_replays(replays: list[dict]) -> str:
 
 def worst_grid_runs(records: list[dict], count: int = WORST_PER_CONTROLLER) -> list[dict]:
     """The grid's worst failed runs per controller (see the module docstring)."""
-    failed = [
-        {**r, "bound": r["capture_bound"]} for r in records if r["outcome"] != "recovered"
-    ]
+    failed = [{**r, "bound": r["capture_bound"]} for r in records if r["outcome"] != "recovered"]
     return _worst(failed, count)
 
 

@@ -14,8 +14,8 @@ from planner.parameters import CONTROLLERS
 from planner.types import Push
 
 from .overrides import check_overrides
-from .result_folder import prepare_out
 from .replay import ReplayRecorder
+from .result_folder import prepare_out
 from .results import write_results
 from .runner import RunResult, run_closed_loop
 from .scenarios import describe_push, load_scenario
@@ -133,7 +133,13 @@ def run_command(args: argparse.Namespace) -> int:
             )
         bar = ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet)
         result = run_closed_loop(
-            backend, config, scaled, initial, progress=bar, planner=planner, interruptible=True,
+            backend,
+            config,
+            scaled,
+            initial,
+            progress=bar,
+            planner=planner,
+            interruptible=True,
             on_tick=recorder,
         )
         if result.interrupted and bar.enabled:
