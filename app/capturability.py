@@ -1,67 +1,54 @@
-"""N-step capturability of the LIPM as an impulse bound per push direction.
+"""The largest push any controller can capture on the LIPM: the yardstick of ``rsg sweep``.
 
-The physical limit a step controller is measured against in ``rsg sweep``.
+The bound is an upper limit for every controller on the LIPM with the controller's
+limits and the LIPM backend's fall rule, causal or not. Derivation and measurements:
+``docs/bound.md``. In short, with the DCM xi = c + cdot / omega and the convergent
+component zeta = c - cdot / omega (per axis, c = (xi + zeta) / 2):
 
-Model (Koolen et al., IJRR 2012, "Capturability-based analysis and control of legged
-locomotion, Part 1"): the DCM (instantaneous capture point) xi = c + cdot / omega
-obeys xidot = omega (xi - r) with the CMP r held in a window around the stance ankle
-o, and a step moves the ankle by u within the step bounds no earlier than the minimum
-step time T_min = T_DSP + T_SP after the previous step. With x = xi - o (DCM relative
-to the ankle), a constant r for a time t gives x(t) = r + (x0 - r) e^(omega t), so per
-axis the DCM can be anywhere in [r_max + (x0 - r_max) e^(wt), r_min + (x0 - r_min)
-e^(wt)] at time t. A state is N-step capturable when some N steps (or fewer) bring the
-DCM into the window of the last stance foot, where it can be held still.
+    xidot = omega (xi - r) + f / (m omega),   zetadot = -omega (zeta - r) - f / (m omega),
 
-Per axis (1-D) the capturable set is an interval [a_N, b_N], with a_0 = r_min,
-b_0 = r_max and, stepping as early as allowed (it only helps while the DCM diverges):
+r the CMP, f the push force. A controller chooses r(t), the step times and the steps
+u_k = o_k - o_{k-1}; the limits it has (all of them are kept):
 
-    b_N = max(b_{N-1}, (l_max + b'_{N-1} - r_max) e^(-omega t) + r_max),
-    a_N = min(a_{N-1}, (l_min + a'_{N-1} - r_min) e^(-omega t) + r_min),
+- the CMP in the ZMP window widened by hdot_max / (m g) per axis around the stance
+  ankle, and in double support (T_DSP after a step) anywhere between the windows of the
+  two feet (per axis), which contains the paper's moving window (7), (8);
+- steps in the box (27d), laterally on the swing foot's own side (27b), the first no
+  sooner than the swing foot is ready (T_min = T_DSP + T_SP after the last step, the
+  controller's gate), later ones T_min apart; during the push if that helps;
+- the LIPM backend's fall rule: the CoM within ``leg_reach`` (0.6 m) of the stance ankle.
 
-where l_max / l_min are the largest / smallest step along the axis and the primes
-are the intervals of the next stance foot. With symmetric bounds this is Koolen's
-d_N = (l_max + d_{N-1} - r_max) e^(-omega t_min) + r_max, d_0 = r_max, whose limit is
-d_inf = r_max + l_max e^(-omega t) / (1 - e^(-omega t)).
+Left out, each a relaxation (fewer limits can only raise the bound): the fall rule on
+the DCM error (it depends on the controller's reference), (27c) (the QP drops it when
+it is infeasible), and anything a particular controller adds (the QP's own leg reach,
+push hold, reaction time).
 
-Which foot steps next: the crossing constraint (27b) lets the swing foot land only
-on its own side, at least 2 w_y + mu_2 from the stance ankle laterally. So in y the
-step range alternates with the stance foot (a right step from the left stance has
-u_y in [u_y^m, -(2 w_y + mu_2)], the left step after it u_y in [2 w_y + mu_2,
-u_y^M]), and the y interval depends on the stance foot sigma: a push towards the
-stance side first forces a step the wrong way, which the recursion accounts for. In x
-the range is [u_x^m, u_x^M] for both feet.
+The push (its force over [0, Delta] and its direction) is known to the bound from its
+start: an upper limit may be non-causal. Viability is what is bounded: a state from
+which no choice avoids a fall is lost; "recovered" implies viable.
 
-The 2-D capturable set lies inside the product of the two 1-D intervals (each
-axis alone, with its own free timing, is a relaxation of the coupled problem), so
-the box [a_N, b_N]^2 is an upper bound; it is exact for pushes along an axis.
+Computation (:mod:`app.capture_lp`): for the step times in given windows, the largest
+impulse is bounded by a linear programme in which every relaxation only widens the
+feasible set (the CMP's effect per time cell through its two exact moments, the reach
+at sample instants on a circumscribed polygon, the feet's windows merged while a step
+may or may not have happened, and after two explicit steps the per-axis capture
+interval below, which has no reach). Branch and bound over the step-time windows
+returns the largest relaxed value among windows no wider than ``LEAF_WIDTH``, which is
+an upper limit over all step times.
 
-Impulse: during a push of force f over Delta, xidot = omega (xi - r) + f / (m omega).
-For all times after the push, the state equals that of an instantaneous DCM jump at
-the push start of i / (m omega) * kappa, kappa = (1 - e^(-omega Delta)) / (omega
-Delta) (-> 1 for a short push), under the same CMP and steps (the DCM is linear in
-f and the step is a shift of the frame). The largest impulse along unit direction d
-is s* m omega / kappa, with s* the largest s such that x0 + s d stays in the capture
-box, x0 the nominal DCM at the push.
+Per-axis capture interval (Koolen et al., IJRR 2012, "Capturability-based analysis
+and control of legged locomotion, Part 1", extended by the double-support hull and
+the crossing rule): B_sigma, the largest DCM offset x = xi - o from the ankle of
+stance sigma from which a step now still captures, obeys
 
-When the first step may come: t_1 = max(T_min - s~, Delta) after the push start
-(s~: time since the last step at the push), later ones every T_min. T_min - s~ is
-the swing foot's readiness, measured from the last touchdown as the controller's
-gate s~ >= T_DSP + T_SP. The Delta is causality: the equivalent jump above lumps
-the whole impulse at the push start, but a controller measures the push only as it
-acts (its size and end are unknown beforehand), so a step before the push ends
-would be placed for an impulse not yet applied. A bound that lets the first step
-land at the push start, placed for the whole impulse (t_1 = max(0, T_min - s~), an
-earlier version), is a bound for a controller that knows the push in advance: at
-phases with s~ >= T_min it was 30-40% above what any causal controller can reach
-(e.g. 255 instead of 187 N s forward at phase 0.5). Between the push start and t_1
-the CMP may sit anywhere in its window (the push direction is measured from its
-first instant), which the per-axis box already allows. For s~ <= T_min - Delta
-(phases 0 and 0.25 of the default gait) the two forms agree.
+    B_sigma = hi_sigma + max(0, -hi_sigma)(1 - e^(-omega T_DSP)) + r_max
+              + max(0, B_{-sigma} - r_max) e^(-omega T_min),
 
-CMP window: by default the window is the ZMP window widened by the feedback rate of
-change of angular momentum, |hdot| <= hdot_max shifts the CMP by up to
-hdot_max / (m g) per axis (H is an axis swap), which the LIPM backend realises. With
-``include_angular_momentum=False`` it is the ZMP window alone.
+hi_sigma the largest step along the axis from stance sigma (negative for the step
+(27b) forces the wrong way; the hull then keeps the CMP at the old foot in double
+support), and A_sigma likewise with the smallest step and r_min. With steps of l_max
+along x this is Koolen's d_inf = r_max + l_max e^(-omega T) / (1 - e^(-omega T)) plus
+the step l_max taken now.
 """
 
 from __future__ import annotations
@@ -75,7 +62,7 @@ from planner.exceptions import ParameterError
 from planner.parameters import PlannerConfig
 from planner.reference_model import NominalOrbit
 
-MAX_STEPS = 50  # the recursion converges geometrically (ratio e^(-omega T_min))
+from .lipm_backend import LEG_REACH
 
 
 @dataclass(frozen=True)
@@ -91,6 +78,8 @@ class CaptureModel:
         step_max: Largest step u_d (x, y) [m].
         min_lateral_step: 2 w_y + mu_2, the smallest lateral step of (27b) [m].
         min_step_time: T_DSP + T_SP, the shortest time between steps [s].
+        double_support_duration: T_DSP, after a step the CMP may lie between both feet [s].
+        leg_reach: Largest CoM distance from the stance ankle (the fall rule) [m].
     """
 
     omega: float
@@ -101,24 +90,32 @@ class CaptureModel:
     step_max: tuple[float, float]
     min_lateral_step: float
     min_step_time: float
+    double_support_duration: float
+    leg_reach: float = LEG_REACH
 
     def __post_init__(self) -> None:
-        for name in ("omega", "mass", "min_step_time"):
+        for name in ("omega", "mass", "min_step_time", "double_support_duration", "leg_reach"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
                 raise ParameterError(name, value, "a finite number > 0")
+        if not self.double_support_duration < self.min_step_time:
+            raise ParameterError(
+                "double_support_duration", self.double_support_duration, "< min_step_time"
+            )
         if not all(lo < 0.0 < hi for lo, hi in zip(self.cmp_min, self.cmp_max, strict=True)):
             raise ParameterError("cmp_min/cmp_max", (self.cmp_min, self.cmp_max), "min < 0 < max")
         if not self.step_min[1] < -self.min_lateral_step < self.min_lateral_step < self.step_max[1]:
             raise ParameterError(
                 "min_lateral_step", self.min_lateral_step, "inside the lateral step bounds"
             )
+        if not self.step_min[0] < self.step_max[0]:
+            raise ParameterError("step_min/step_max x", (self.step_min, self.step_max), "min < max")
 
     @classmethod
     def from_config(
         cls, config: PlannerConfig, include_angular_momentum: bool = True
     ) -> CaptureModel:
-        """The limits the controller of ``config`` works with."""
+        """The limits the controller of ``config`` works with, and the LIPM's leg reach."""
         cons, model = config.constraints, config.model
         shift = 0.0
         if include_angular_momentum:
@@ -128,10 +125,11 @@ class CaptureModel:
             mass=model.mass,
             cmp_min=(cons.zmp_window_min[0] - shift, cons.zmp_window_min[1] - shift),
             cmp_max=(cons.zmp_window_max[0] + shift, cons.zmp_window_max[1] + shift),
-            step_min=tuple(cons.step_min),  # type: ignore[arg-type]
-            step_max=tuple(cons.step_max),  # type: ignore[arg-type]
+            step_min=(cons.step_min[0], cons.step_min[1]),
+            step_max=(cons.step_max[0], cons.step_max[1]),
             min_lateral_step=2.0 * cons.half_width + config.rsg.crossing_margin,
             min_step_time=config.gait.double_support_duration + config.rsg.swing_preparation_time,
+            double_support_duration=config.gait.double_support_duration,
         )
 
     def step_range(self, axis: int, sigma: int) -> tuple[float, float]:
@@ -164,83 +162,69 @@ def capture_distance(
     return distance
 
 
-def _interval_after(
-    model: CaptureModel, axis: int, sigma: int, t: float, nxt: tuple[float, float]
-) -> tuple[float, float]:
-    """Interval of x0 from which one step after ``t`` [s] reaches ``nxt`` of the new stance."""
-    u_lo, u_hi = model.step_range(axis, sigma)
-    r_lo, r_hi = model.cmp_min[axis], model.cmp_max[axis]
-    decay = math.exp(-model.omega * t)
-    return r_lo + (nxt[0] + u_lo - r_lo) * decay, r_hi + (nxt[1] + u_hi - r_hi) * decay
+@dataclass(frozen=True)
+class CaptureEdges:
+    """Per-axis capture interval of the DCM offset x = xi - o from the stance ankle [m].
 
-
-def capture_box(
-    model: CaptureModel, sigma: int, first_step_time: float, n_steps: float = math.inf
-) -> tuple[np.ndarray, np.ndarray]:
-    """The N-step capture box (lo, hi) of the DCM relative to the stance ankle [m].
-
-    Args:
-        model: Limits.
-        sigma: Stance foot at the push (+1 left, -1 right).
-        first_step_time: Earliest first step after the push [s] (>= 0).
-        n_steps: N, or ``math.inf`` (iterated to convergence).
+    ``lower[axis][sigma]`` / ``upper[axis][sigma]`` (sigma +1 left, -1 right stance):
+    the extreme offsets from which stepping at once still captures. :meth:`interval`
+    adds waiting: the union with [r_min, r_max] of the stance foot's own window.
     """
-    if not (first_step_time >= 0.0 and n_steps >= 0):
-        raise ParameterError("first_step_time/n_steps", (first_step_time, n_steps), ">= 0")
-    count = MAX_STEPS if math.isinf(n_steps) else int(n_steps)
-    lo, hi = np.zeros(2), np.zeros(2)
+
+    lower: dict[int, dict[int, float]]
+    upper: dict[int, dict[int, float]]
+    cmp_min: tuple[float, float]
+    cmp_max: tuple[float, float]
+
+    def interval(self, axis: int, sigma: int) -> tuple[float, float]:
+        """Offsets [m] capturable from stance ``sigma`` out of double support, stepping
+        now or at any later time (no leg reach: a relaxation of it)."""
+        return (
+            min(self.lower[axis][sigma], self.cmp_min[axis]),
+            max(self.upper[axis][sigma], self.cmp_max[axis]),
+        )
+
+
+def capture_edges(model: CaptureModel) -> CaptureEdges:
+    """The fixed point of the per-axis recursion (module docstring)."""
+    decay = math.exp(-model.omega * model.min_step_time)
+    hull = 1.0 - math.exp(-model.omega * model.double_support_duration)
+    lower: dict[int, dict[int, float]] = {}
+    upper: dict[int, dict[int, float]] = {}
     for axis in (0, 1):
-        window = (model.cmp_min[axis], model.cmp_max[axis])
-        # inner[s]: interval with k steps left, stance s, steps every T_min.
-        inner = {1: window, -1: window}
-        for _ in range(max(count - 1, 0)):
-            inner = {
-                s: _hull(inner[s], _interval_after(model, axis, s, model.min_step_time, inner[-s]))
+        r_lo, r_hi = model.cmp_min[axis], model.cmp_max[axis]
+        ranges = {s: model.step_range(axis, s) for s in (1, -1)}
+        up = {s: ranges[s][1] + max(0.0, -ranges[s][1]) * hull + r_hi for s in (1, -1)}
+        lo = {s: ranges[s][0] + min(0.0, -ranges[s][0]) * hull + r_lo for s in (1, -1)}
+        for _ in range(10_000):  # a contraction with rate e^(-omega T_min)
+            new_up = {
+                s: ranges[s][1] + max(0.0, -ranges[s][1]) * hull + r_hi
+                + max(0.0, up[-s] - r_hi) * decay
                 for s in (1, -1)
-            }
-        outer = window
-        if count >= 1:
-            first = _interval_after(model, axis, sigma, first_step_time, inner[-sigma])
-            outer = _hull(inner[sigma], first)
-        lo[axis], hi[axis] = outer
-    return lo, hi
+            }  # fmt: skip
+            new_lo = {
+                s: ranges[s][0] + min(0.0, -ranges[s][0]) * hull + r_lo
+                + min(0.0, lo[-s] - r_lo) * decay
+                for s in (1, -1)
+            }  # fmt: skip
+            change = max(abs(new_up[s] - up[s]) + abs(new_lo[s] - lo[s]) for s in (1, -1))
+            up, lo = new_up, new_lo
+            if change < 1e-14:
+                break
+        lower[axis], upper[axis] = lo, up
+    return CaptureEdges(lower, upper, model.cmp_min, model.cmp_max)
 
 
-def _hull(a: tuple[float, float], b: tuple[float, float]) -> tuple[float, float]:
-    if b[0] > b[1]:  # empty: that step cannot help
-        return a
-    return min(a[0], b[0]), max(a[1], b[1])
-
-
-def max_dcm_shift(x0: np.ndarray, direction: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
-    """Largest s >= 0 with x0 + s d inside the box [lo, hi] [m] (0 if x0 is outside)."""
-    x0, d = np.asarray(x0, float), np.asarray(direction, float)
-    if np.any(x0 < lo - 1e-12) or np.any(x0 > hi + 1e-12):
-        return 0.0
-    best = math.inf
-    for axis in (0, 1):
-        if d[axis] > 1e-12:
-            best = min(best, (hi[axis] - x0[axis]) / d[axis])
-        elif d[axis] < -1e-12:
-            best = min(best, (lo[axis] - x0[axis]) / d[axis])
-    return max(best, 0.0)
-
-
-def push_discount(omega: float, push_duration: float) -> float:
-    """kappa = (1 - e^(-omega Delta)) / (omega Delta): DCM jump per i / (m omega) [-]."""
-    x = omega * push_duration
-    return 1.0 if x < 1e-9 else (1.0 - math.exp(-x)) / x
-
-
-def first_step_time(min_step_time: float, time_since_step: float, push_duration: float) -> float:
-    """Earliest first step after the push start [s]: the swing foot ready, the push over."""
-    return max(min_step_time - time_since_step, push_duration, 0.0)
+def nominal_state(config: PlannerConfig, sigma: int, time_since_step: float) -> np.ndarray:
+    """(c - o, cdot) on the nominal orbit, ``time_since_step`` [s] after a step onto
+    ``sigma`` [m, m/s], shape (4,)."""
+    orbit = NominalOrbit(config.model.omega, config.gait)
+    return orbit.state_at(sigma, time_since_step)
 
 
 def nominal_dcm(config: PlannerConfig, sigma: int, time_since_step: float) -> np.ndarray:
     """DCM relative to the stance ankle on the nominal orbit [m]."""
-    orbit = NominalOrbit(config.model.omega, config.gait)
-    state = orbit.state_at(sigma, time_since_step)
+    state = nominal_state(config, sigma, time_since_step)
     return state[:2] + state[2:] / config.model.omega
 
 
@@ -250,10 +234,10 @@ def impulse_bound(
     sigma: int,
     time_since_step: float,
     push_duration: float,
-    n_steps: float = math.inf,
     include_angular_momentum: bool = True,
 ) -> float:
-    """Largest capturable impulse [N s] along ``angle`` [rad] from the nominal gait.
+    """Largest impulse [N s] along ``angle`` [rad] any controller can capture from the
+    nominal gait on the LIPM with ``config``'s limits (module docstring).
 
     Args:
         config: The controller's parameters (mass, window, steps, timing).
@@ -261,12 +245,29 @@ def impulse_bound(
         sigma: Stance foot at the push start (+1 left, -1 right).
         time_since_step: s~ at the push start [s].
         push_duration: Delta [s].
-        n_steps: N of the N-step bound (default: the limit N -> inf).
         include_angular_momentum: Widen the window by hdot_max / (m g).
+
+    Raises:
+        ParameterError: A bad push or limit.
     """
+    from .capture_lp import PushCase, largest_impulse
+
+    if not (math.isfinite(time_since_step) and time_since_step >= 0.0):
+        raise ParameterError("time_since_step", time_since_step, "a finite number >= 0")
+    if not (math.isfinite(push_duration) and push_duration > 0.0):
+        raise ParameterError("push_duration", push_duration, "a finite number > 0")
+    if sigma not in (1, -1):
+        raise ParameterError("sigma", sigma, "+1 (left stance) or -1 (right stance)")
     model = CaptureModel.from_config(config, include_angular_momentum)
-    first = first_step_time(model.min_step_time, time_since_step, push_duration)
-    lo, hi = capture_box(model, sigma, first, n_steps)
-    x0 = nominal_dcm(config, sigma, time_since_step)
-    shift = max_dcm_shift(x0, np.array([math.cos(angle), math.sin(angle)]), lo, hi)
-    return shift * model.mass * model.omega / push_discount(model.omega, push_duration)
+    state = nominal_state(config, sigma, time_since_step)
+    orbit = NominalOrbit(config.model.omega, config.gait)
+    case = PushCase(
+        com=state[:2],
+        velocity=state[2:],
+        sigma=sigma,
+        time_since_step=time_since_step,
+        previous_step=-2.0 * orbit.state_after_step(sigma)[:2],
+        direction=np.array([math.cos(angle), math.sin(angle)]),
+        duration=push_duration,
+    )
+    return largest_impulse(model, case).impulse

@@ -1,4 +1,5 @@
-"""The ``rsg`` command line: ``rsg run``, ``rsg sweep``, ``rsg grid``, ``rsg bench``, plug-ins.
+"""The ``rsg`` command line: ``rsg run``, ``sweep``, ``grid``, ``pushes``, ``protocol``, ``bench``,
+plug-ins.
 
 Packages that sit above ``app`` (the browser demo in ``web``) add their commands
 through the entry-point group ``rsg.commands`` (see pyproject.toml): each entry is a
@@ -19,6 +20,7 @@ from planner.parameters import CONTROLLERS
 from .overrides import add_robot_argument, add_set_argument, parse_decimal
 from .result_folder import add_out_arguments
 from .scenarios import BUILT_IN, MAX_DURATION, parse_push
+from .setup import PAPER_RULES_HELP
 
 MODELS = ("lipm", "pybullet")
 DEFAULT_MODEL = "pybullet"
@@ -35,6 +37,7 @@ outputs in --out (a folder with an earlier run's results is refused without --ov
   summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
+  replay.npz       the run for the browser: rsg replay FOLDER
 
 exit code: 0 recovered, 1 not recovered, 2 bad input, 130 interrupted (Ctrl-C: what was
 simulated is written, summary.json says "interrupted": true)
@@ -129,8 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--paper-rules",
         action="store_true",
-        help="the RSG without the documented extensions (push hold, leg reach in the "
-        "step QP, step reaction time): the paper's jump set and QP (27) as printed",
+        help=PAPER_RULES_HELP,
     )
     add_set_argument(run)
     run.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
@@ -144,11 +146,15 @@ def build_parser() -> argparse.ArgumentParser:
     for command in plugin_commands().values():
         command.add_parser(sub)
     from .bench import add_bench_parser
+    from .campaign_command import add_campaign_parser
     from .grid_command import add_grid_parser
+    from .protocol_command import add_protocol_parser
     from .sweep_command import add_sweep_parser
 
     add_sweep_parser(sub)
     add_grid_parser(sub)
+    add_campaign_parser(sub)
+    add_protocol_parser(sub)
     add_bench_parser(sub)
     return parser
 
@@ -173,6 +179,14 @@ def main(argv: list[str] | None = None) -> int:
             from .grid_command import grid_command
 
             return grid_command(args)
+        if args.command == "pushes":
+            from .campaign_command import campaign_command
+
+            return campaign_command(args)
+        if args.command == "protocol":
+            from .protocol_command import protocol_command
+
+            return protocol_command(args)
         if args.command == "bench":
             from .bench import bench_command
 

@@ -18,10 +18,11 @@ CSV_COLUMNS = ("controller", "phase", "direction_deg", "impulse", "bound", "rati
                "runs", "stance", "push_time")  # fmt: skip
 
 BOUND_NOTE = (
-    "bound: largest impulse [N s] along the direction from which the LIPM with the "
-    "controller's CMP window (ZMP window + hdot_max/(m g)), step bounds, crossing "
-    "constraint (27b) and minimum step time T_DSP + T_SP is N-step capturable for N -> inf "
-    "(Koolen et al. 2012, per axis; see app/capturability.py)"
+    "bound: an upper limit on the impulse [N s] along the direction that any controller "
+    "can capture on the LIPM with the controller's CMP window (ZMP window + hdot_max/(m g), "
+    "both feet in double support), step bounds, crossing constraint (27b), minimum step "
+    "time T_DSP + T_SP and the 0.6 m leg reach, stepping during the push if that helps "
+    "and knowing the push in advance (app/capturability.py, docs/bound.md)"
 )
 
 

@@ -8,8 +8,15 @@ import time
 
 from .overrides import add_robot_argument, add_set_argument, decimal_argument, parse_decimal
 from .push_grid import GridSpec, format_grid, run_grid, write_grid
+from .replay_keep import (
+    add_replays_argument,
+    format_replays,
+    worst_grid_runs,
+    write_worst_replays,
+)
 from .result_folder import add_out_arguments, prepare_out
 from .robot_setup import check_robot_overrides
+from .setup import PAPER_RULES_HELP
 from .sweep import SWEEP_CONTROLLERS, check_workers
 
 EPILOG = """\
@@ -23,6 +30,7 @@ outputs in --out:
   grid.json   the specification, counts per controller, phase and impulse, every run
   grid.csv    one row per run: controller, phase, direction, impulse, outcome, ...
   grid.png    outcome per impulse and direction, one panel per controller and phase
+  replays/*/  the worst failed runs per controller: rsg replay FOLDER
 """
 
 
@@ -71,14 +79,14 @@ def add_grid_parser(sub: argparse._SubParsersAction) -> None:
         default=GridSpec.settle,
         help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
     )
-    p.add_argument("--paper-rules", action="store_true",
-                   help="the RSG without the documented extensions")  # fmt: skip
+    p.add_argument("--paper-rules", action="store_true", help=PAPER_RULES_HELP)
     p.add_argument("--workers", type=int, default=None,
                    help="parallel workers (default: the CPU count; at most 4 per CPU, and "
                    "never more than there are runs)")  # fmt: skip
     add_out_arguments(p)
     add_set_argument(p)
     p.add_argument("--no-plots", action="store_true", help="skip grid.png")
+    add_replays_argument(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
@@ -105,8 +113,12 @@ def grid_command(args: argparse.Namespace) -> int:
         print(f"deleted {path} (--overwrite)")
     started = time.perf_counter()
     records = run_grid(spec, workers, progress=not args.quiet)
+    worst = worst_grid_runs(records, args.replays)
+    if worst and not args.quiet:
+        print(f"grid: simulating the {len(worst)} worst failed runs again to replay them ...")
+    replays = write_worst_replays(spec, worst, args.out)
     wall_time = time.perf_counter() - started
-    paths = write_grid(args.out, spec, records, wall_time)
+    paths = write_grid(args.out, spec, records, wall_time, replays)
     if not args.no_plots:
         from .grid_plot import plot_grid
 
@@ -114,5 +126,6 @@ def grid_command(args: argparse.Namespace) -> int:
     for path in paths:
         print(f"wrote {path}")
     print(format_grid(spec, records))
+    print(format_replays(replays))
     print(f"grid: {len(records)} runs, {wall_time:.0f} s wall time")
     return 0

@@ -21,6 +21,7 @@ from planner.types import MeasuredState, PlannerOutput, Vector2
 from .backend import FallStatus, InitialCondition
 
 CONTROL_PERIOD = 0.001  # [s] the loop's tick on the point mass (1 kHz)
+LEG_REACH = 0.6  # [m] CoM to stance-ankle distance beyond which the LIPM counts a fall
 
 
 class LipmBackend:
@@ -39,7 +40,7 @@ class LipmBackend:
         self,
         model: LipmModel,
         control_period: float = CONTROL_PERIOD,
-        fall_distance: float = 0.6,
+        fall_distance: float = LEG_REACH,
         fall_dcm_error: float = 0.5,
     ) -> None:
         self.model = model

@@ -116,8 +116,8 @@ def _paper_point_mass(model: str, robot: str | None) -> bool:
 
 def rsg_parameter_types(model: str = "pybullet", robot: str | None = None) -> dict[str, str]:
     """RSG parameters ``--set`` may change on ``model`` -> their kind (``"float"``,
-    ``"float | None"``): all of them on the paper's LIPM; with a robot those its
-    description does not set."""
+    ``"float | None"``, ``"bool"``): all of them on the paper's LIPM; with a robot those
+    its description does not set."""
     paper = _paper_point_mass(model, robot)
     return {
         f.name: str(f.type)

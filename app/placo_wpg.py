@@ -222,7 +222,7 @@ class PlacoWalkPlanner:
     def __init__(self, description: RobotDescription, config: PlannerConfig) -> None:
         import placo
 
-        from kinematics.whole_body_ik import kinematic_urdf_text
+        from kinematics.whole_body_ik import humanoid_robot
 
         self.description = description
         self.config = config
@@ -234,9 +234,7 @@ class PlacoWalkPlanner:
         sole = description.sole
         self.sole_center = np.array([0.5 * (sole.x_min + sole.x_max), 0.0])
         self.parameters = humanoid_parameters(description, config)
-        self.robot = placo.HumanoidRobot(
-            "", placo.Flags.ignore_collisions, kinematic_urdf_text(description)
-        )
+        self.robot = humanoid_robot(description)
         self.wpg = placo.WalkPatternGenerator(self.robot, self.parameters)
         self.footsteps = placo.FootstepsPlannerRepetitive(self.parameters)
         self.footsteps.configure(config.gait.stride_length, 0.0, 0.0, STEPS_AHEAD + 1)

@@ -4,17 +4,14 @@ The sweep (:mod:`app.sweep`) bisects the largest recovered impulse per direction
 which assumes recovery is monotonic in the impulse. On the full robot it is not
 (G1 at 45 deg, mid single support: 4 and 8 N s survived, 6 and 10 N s fell), so a
 bisection can stop at any of several thresholds. The grid runs each
-(controller, phase, direction, impulse) once and reports each outcome:
-
-* ``recovered``: no fall, V_u below gamma_v at the end and the last two steps
-  nominal (:attr:`app.runner.RunResult.recovered`);
-* ``survived``: no fall within ``settle`` after the push start;
-* ``fell``.
+(controller, phase, direction, impulse) once and reports each outcome: recovered,
+survived (no fall within ``settle`` after the push start) or fell
+(:mod:`app.push_outcome`).
 
 Each record also carries the push's capture bound (:func:`app.capturability.impulse_bound`
 with the controller's configuration: the largest impulse in that direction and at
-that time that any stepping controller could recover on the LIPM with the robot's
-ZMP window, step bounds and step timing). A fall above it is a limit of the robot's
+that time that any controller could capture on the LIPM with the robot's ZMP window,
+step bounds, step timing and leg reach). A fall above it is a limit of the robot's
 parameters, not of a controller; the printed grid writes those outcomes in capitals.
 
 Counts over the grid compare controllers without the monotonicity assumption.
@@ -28,19 +25,16 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-import numpy as np
-
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
 from .capturability import impulse_bound
 from .overrides import Overrides
-from .scenarios import Scenario
+from .push_outcome import OUTCOMES, PushRun, describe, impulse_along
 from .setup import resolve_robot
-from .sweep import JobProgress, build_controller, check_pushes, check_workers, run_in_processes
+from .sweep import JobProgress, check_pushes, check_workers, run_in_processes
 from .sweep_trial import push_timing
 
-OUTCOMES = ("recovered", "survived", "fell")
 MAX_IMPULSES = 100
 
 
@@ -59,7 +53,7 @@ class GridSpec:
         duration: Push duration [s].
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
-        paper_rules: The RSG without the documented extensions.
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
     """
@@ -125,37 +119,19 @@ def all_grid_jobs(spec: GridSpec) -> list[GridJob]:
 
 def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
     """One push; returns its JSON-ready record."""
-    from .runner import run_closed_loop
-
     started = time.perf_counter()
-    backend, config, initial, planner = build_controller(spec, job.controller)
-    runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
-    options = {} if planner is None else {"planner": planner}
-    try:
-        t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
-        angle = math.radians(job.direction_deg)
-        bound = impulse_bound(config, angle, sigma, since, spec.duration)
-        direction = np.array([math.cos(angle), math.sin(angle)])
-        push = Push(t_push, job.impulse * direction, spec.duration)
-        scenario = Scenario("grid", t_push + spec.settle, (push,))
-        result = runner(backend, config, scenario, initial, qp_solver="exact", **options)
-    finally:
-        backend.close()
-    if result.recovered:
-        outcome = "recovered"
-    elif not result.fall.fell:
-        outcome = "survived"
-    else:
-        outcome = "fell"
+    trial = PushRun(spec, job.controller)
+    t_push, sigma, since = push_timing(trial.config, spec.cycle, job.phase)
+    angle = math.radians(job.direction_deg)
+    bound = impulse_bound(trial.config, angle, sigma, since, spec.duration)
+    push = Push(t_push, impulse_along(job.direction_deg, job.impulse), spec.duration)
+    result = trial.run(push, t_push + spec.settle)
     return {
         **asdict(job),
-        "outcome": outcome,
+        **describe(result, push, job.controller),
         "push_time": t_push,
         "stance": "left" if sigma > 0 else "right",
         "capture_bound": bound,
-        "end_time": result.sim_time,
-        "fall_reason": result.fall.reason,
-        "adjusted_steps": sum(bool(s.event["adjusted"]) for s in result.steps),
         "wall_time": time.perf_counter() - started,
     }
 
@@ -212,8 +188,15 @@ def _counts(rows: list[dict]) -> dict[str, int]:
     return counts
 
 
-def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float) -> list[Path]:
-    """``grid.json`` (spec, summary, records) and ``grid.csv`` (one row per run)."""
+def write_grid(
+    out: Path,
+    spec: GridSpec,
+    records: list[dict],
+    wall_time: float,
+    replays: list[dict] | None = None,
+) -> list[Path]:
+    """``grid.json`` (spec, summary, records, replays of the worst runs) and ``grid.csv``
+    (one row per run)."""
     try:
         out.mkdir(parents=True, exist_ok=True)
         document = {
@@ -231,6 +214,7 @@ def write_grid(out: Path, spec: GridSpec, records: list[dict], wall_time: float)
             },
             "summary": summarize(spec, records),
             "records": records,
+            "replays": replays or [],
             "wall_time": wall_time,
         }
         json_path = out / "grid.json"

@@ -18,17 +18,20 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
-import pybullet
-import pybullet_data
 from numpy.typing import NDArray
-from pybullet_utils.bullet_client import BulletClient
 
+from kinematics.native_output import native_output_silenced
 from kinematics.robot_model import RobotModel
 from robots.description import RobotDescription
 from robots.urdf_cache import derived_urdf
 
 from .joint_motors import JointMotors
 from .lowlevel import FootForce, JointCommand, RobotMeasurement
+
+with native_output_silenced():  # pybullet prints its build time when first imported
+    import pybullet
+    import pybullet_data
+    from pybullet_utils.bullet_client import BulletClient
 
 GRAVITY = 9.81  # [m/s^2]
 
@@ -48,7 +51,8 @@ class SimulatedRobot:
     def __init__(self, description: RobotDescription) -> None:
         self.description = description
         self.time_step = description.physics_time_step
-        self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        with native_output_silenced():  # pybullet prints "argv[0]=" at connect
+            self.client = BulletClient(connection_mode=pybullet.DIRECT)
         client = self.client
         client.setGravity(0.0, 0.0, -GRAVITY)
         client.setPhysicsEngineParameter(

@@ -33,7 +33,23 @@ RESULT_FILES: dict[str, tuple[str, ...]] = {
         "fig6b_time_since_step.png",
         "fig6c_dcm_error.png",
     ),
-    "sweep": ("envelope.json", "envelope.csv", "envelope.png", "jobs.jsonl", "sweep_spec.json"),
+    "sweep": (
+        "envelope.json",
+        "envelope.csv",
+        "envelope.png",
+        "monotonicity.json",
+        "jobs.jsonl",
+        "sweep_spec.json",
+    ),
+    "monotonicity": ("jobs.jsonl", "sweep_spec.json"),
+    "protocol": ("protocol.json", "protocol.csv", "jobs.jsonl", "sweep_spec.json"),
+    "pushes": (
+        "campaign.json",
+        "campaign.csv",
+        "campaign.png",
+        "jobs.jsonl",
+        "campaign_spec.json",
+    ),
     "grid": ("grid.json", "grid.csv", "grid.png"),
     "bench": ("bench.json",),
 }
@@ -98,7 +114,7 @@ def prepare_out(
 
     Args:
         out: The ``--out`` folder.
-        command: ``run``, ``sweep``, ``grid`` or ``bench`` (:data:`RESULT_FILES`).
+        command: A key of :data:`RESULT_FILES`.
         overwrite: Delete an earlier run's result files instead of refusing the folder.
         resumable: Result files that may stay (a resumed sweep's own).
 

@@ -14,6 +14,7 @@ from planner.parameters import CONTROLLERS
 from planner.types import Push
 
 from .overrides import check_overrides
+from .replay import ReplayRecorder
 from .result_folder import prepare_out
 from .results import write_results
 from .runner import RunResult, run_closed_loop
@@ -122,6 +123,7 @@ def run_command(args: argparse.Namespace) -> int:
         physics_log = backend.physics_log = PhysicsLog()
     if overrides:
         print("with " + " ".join(f"--set {name}={value}" for name, value in overrides))
+    recorder = ReplayRecorder()
     try:
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:
@@ -131,7 +133,14 @@ def run_command(args: argparse.Namespace) -> int:
             )
         bar = ProgressBar(f"{args.model}/{args.controller}/{scenario.name}", not args.quiet)
         result = run_closed_loop(
-            backend, config, scaled, initial, progress=bar, planner=planner, interruptible=True
+            backend,
+            config,
+            scaled,
+            initial,
+            progress=bar,
+            planner=planner,
+            interruptible=True,
+            on_tick=recorder,
         )
         if result.interrupted and bar.enabled:
             sys.stderr.write("\n")  # end the bar's line
@@ -157,6 +166,7 @@ def run_command(args: argparse.Namespace) -> int:
         print(f"wrote {physics_log.write(out / 'physics.csv')}")
     if not args.no_plots and len(result.timeseries) >= 2:
         print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
+    print(f"wrote {recorder.write(result, args.controller, robot, out)} (rsg replay {out})")
     print(verdict(result))
     if result.interrupted:
         return EXIT_INTERRUPTED

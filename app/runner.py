@@ -199,6 +199,8 @@ class ClosedLoop:
         capacity: Ticks to pre-allocate for the time series (grows when needed).
         planner: Builds the planner from ``config``; default the RSG
             (:class:`ReactiveStepGenerator` with ``qp_solver``).
+        record: Keep the time series and the steps (False: a loop that runs
+            without end, e.g. the live demo, keeps memory bounded).
     """
 
     def __init__(
@@ -210,8 +212,10 @@ class ClosedLoop:
         qp_solver: str = "proxqp",
         capacity: int | None = None,
         planner: PlannerFactory | None = None,
+        record: bool = True,
     ) -> None:
         self.backend = backend
+        self.record = record
         self.config = config
         self.scenario = scenario
         self.initial = initial or walking_start(config)
@@ -222,6 +226,8 @@ class ClosedLoop:
         )
         self.period = backend.control_period
         self._capacity = capacity or int(round(scenario.duration / self.period)) + 1
+        if not record:
+            self._capacity = 1
         self.reset()
 
     def reset(self) -> None:
@@ -259,7 +265,8 @@ class ClosedLoop:
         out = self.generator.update(measured, self.period)
         if out.step is not None:
             step = out.stance.position - out.previous_stance.position
-            self.steps.append(StepRecord(out.step.as_dict(), step.tolist()))
+            if self.record:
+                self.steps.append(StepRecord(out.step.as_dict(), step.tolist()))
             self.qp_infeasible += int(out.qp_infeasible)
             for name in _check_step(self.config, step, out.stance.foot):
                 self.violations[name] += 1
@@ -268,15 +275,16 @@ class ClosedLoop:
         # The tick's mean push force: its impulse over [t_k, t_k+1), exact for any push.
         end = (self.ticks + 1) * self.period
         force = self.scenario.impulse_between(time, end) / self.period
-        if self.ticks >= len(self.rows):
-            self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
-        self.rows[self.ticks] = (
-            time, *measured.com_position, *measured.com_velocity,
-            *out.zmp, *out.zmp_offset, *out.window_center,
-            *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
-            *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
-            *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
-        )  # fmt: skip
+        if self.record:
+            if self.ticks >= len(self.rows):
+                self.rows = np.vstack([self.rows, np.zeros_like(self.rows)])
+            self.rows[self.ticks] = (
+                time, *measured.com_position, *measured.com_velocity,
+                *out.zmp, *out.zmp_offset, *out.window_center,
+                *out.angular_momentum_rate, *out.angular_momentum_rate_feedback,
+                *out.stance.position, sigma_of(out.stance.foot), *out.next_step.position,
+                *out.com_reference, *out.dcm_error, out.lyapunov, out.time_since_step, *force,
+            )  # fmt: skip
         self.measured = self.backend.step(out, force)
         self.ticks += 1
         self.last_output = out
@@ -315,6 +323,7 @@ def run_closed_loop(
     qp_solver: str = "proxqp",
     planner: PlannerFactory | None = None,
     interruptible: bool = False,
+    on_tick: Callable[[ClosedLoop, PlannerOutput], None] | None = None,
 ) -> RunResult:
     """Run ``scenario`` with the planner of ``config`` on ``backend``.
 
@@ -329,6 +338,8 @@ def run_closed_loop(
         interruptible: Ctrl-C (SIGINT) stops the run at the end of the current tick
             and returns what was simulated, marked ``interrupted``; a second Ctrl-C
             raises KeyboardInterrupt at once. Only in the main thread.
+        on_tick: Called after every tick with the loop and the tick's output (e.g. a
+            :class:`app.replay.ReplayRecorder`).
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.
@@ -343,7 +354,9 @@ def run_closed_loop(
         for tick in range(ticks):
             if stop.requested:
                 break
-            loop.tick()
+            out = loop.tick()
+            if on_tick is not None:
+                on_tick(loop, out)
             if progress is not None and tick % report_every == 0:
                 progress(tick / ticks)
             if backend.fall_status().fell:

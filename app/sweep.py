@@ -2,8 +2,9 @@
 
 Jobs: one job is (controller, direction, phase). It bisects the impulse magnitude
 [N s] of a single push along the direction between 0 and ``bracket`` times the
-capturability bound (:mod:`app.capturability`) and returns the largest impulse that
-is still recovered, to ``tolerance``. Recovery is assumed monotone in the magnitude.
+capture bound (:mod:`app.capturability`, an upper limit for any controller on the
+LIPM) and returns the largest impulse that is still recovered, to ``tolerance``.
+Recovery is assumed monotone in the magnitude.
 
 Push phase: the LIPM walk starts in single support on the left foot at s~ = T_DSP,
 so nominal step k (k = 1, 2, ...) lands at t_k = T_SSP + (k - 1) T^*. Cycle k is
@@ -38,11 +39,11 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Protocol, TypeVar
+from typing import Any, Protocol, TypeVar
 
 import numpy as np
 
@@ -56,7 +57,7 @@ from .overrides import Overrides, check_overrides
 from .result_folder import RESULT_FILES, ResultFolderError, prepare_out
 from .scenarios import Scenario
 from .setup import DEFAULT_ROBOT, resolve_robot
-from .sweep_trial import SettledTrial, push_timing
+from .sweep_trial import SettledTrial, measured_touchdown, push_timing
 
 PLACO_WPG = "placo-wpg"
 T = TypeVar("T")
@@ -102,7 +103,7 @@ RECORD_FIELDS: dict[str, type | tuple[type, ...]] = {
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
-                 "overrides")  # fmt: skip
+                 "overrides", "timing")  # fmt: skip
 
 
 def check_pushes(
@@ -161,16 +162,19 @@ class SweepSpec:
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
         tolerance: Bisection tolerance on the impulse [N s].
-        bracket: Upper end of the bisection, times the capturability bound [-].
+        bracket: Upper end of the bisection, times the capture bound [-].
         qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
         criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
             backend's own default (0.5 m) is a heuristic below the capturable DCM
             error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
-        paper_rules: The RSG without the documented extensions (push hold, leg
-            reach in the QP, step reaction time; :func:`app.setup.paper_rules`).
+        paper_rules: The paper's rules (:data:`app.setup.PAPER_RULES` off).
         overrides: ``--set`` (name, value) pairs (:mod:`app.overrides`).
+        timing: ``nominal``: the push starts at t_k + phase T^* with t_k the nominal
+            touchdown (:func:`app.sweep_trial.push_timing`); ``touchdown``: t_k is
+            the touchdown measured in the unpushed walk of each controller and model
+            (:func:`app.sweep_trial.measured_touchdown`; ``rsg protocol``).
     """
 
     model: str = "lipm"
@@ -188,12 +192,15 @@ class SweepSpec:
     fall_dcm_error: float = 2.0
     paper_rules: bool = False
     overrides: Overrides = ()
+    timing: str = "nominal"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
         check_pushes(
             self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
         )
+        if self.timing not in ("nominal", "touchdown"):
+            raise ParameterError("timing", self.timing, "nominal or touchdown")
         checks = {
             "duration": (self.duration, 1e-3, 1.0),
             "settle": (self.settle, 1.0, 60.0),
@@ -268,6 +275,9 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
     early = spec.model == "lipm" and spec.criterion == "recovered"
     try:
         t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
+        if spec.timing == "touchdown":
+            touchdown = measured_touchdown(runner, backend, config, initial, spec.cycle, **options)
+            t_push = touchdown + since
         bound = impulse_bound(config, job.angle, sigma, since, spec.duration)
         direction = np.array([math.cos(job.angle), math.sin(job.angle)])
         trial = None
@@ -301,6 +311,7 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
         "capped": found.failed is None,
         "bound": bound,
         "ratio": found.passed / bound if bound > 0 else math.nan,
+        "mass": config.model.mass,
         "runs": len(found.evaluations),
         "evaluations": found.evaluations,
         "wall_time": time.perf_counter() - started,
@@ -348,40 +359,53 @@ class JobProgress:
         sys.stderr.flush()
 
 
-def load_finished(out: Path, spec: SweepSpec) -> dict[str, dict]:
+def load_finished(
+    out: Path,
+    spec: Any,
+    spec_file: str = SPEC_FILE,
+    fields: tuple[str, ...] = RESULT_FIELDS,
+    sweep_records: bool = True,
+) -> dict[str, dict]:
     """Jobs already finished in ``out`` (resume); checks the folder's files.
 
+    Args:
+        spec: A frozen dataclass with defaults (:class:`SweepSpec`, or another
+            command's), stored in ``out / spec_file``; ``fields`` are those that
+            change a job's result.
+        sweep_records: The jobs are the sweep's bisections (their fields are checked);
+            otherwise any JSON object with a ``key``.
+
     Raises:
-        ParameterError: The folder holds a sweep with other result-defining settings.
-        ResultFolderError: ``sweep_spec.json`` or ``jobs.jsonl`` is not one ``rsg sweep``
-            wrote (not UTF-8 JSON, not a specification, a line that is not a job record,
-            a folder), or ``jobs.jsonl`` has no specification beside it.
+        ParameterError: The folder holds a run with other result-defining settings.
+        ResultFolderError: ``spec_file`` or ``jobs.jsonl`` is not one ``rsg`` wrote (not
+            UTF-8 JSON, not a specification, a line that is not a job record, a
+            folder), or ``jobs.jsonl`` has no specification beside it.
     """
-    spec_path, jobs_path = out / SPEC_FILE, out / JOBS_FILE
+    spec_path, jobs_path = out / spec_file, out / JOBS_FILE
     if os.path.lexists(jobs_path) and not os.path.lexists(spec_path):
         raise ResultFolderError(
-            jobs_path, f"has no {SPEC_FILE} beside it to check its jobs against", START_OVER
+            jobs_path, f"has no {spec_file} beside it to check its jobs against", START_OVER
         )
     if os.path.lexists(spec_path):
-        old = _read_spec(spec_path)
+        old = _read_spec(spec_path, type(spec))
         # Tuples as JSON lists, as stored.
-        new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, SweepSpec()))
-        for name in RESULT_FIELDS:  # a field missing from an older spec had its default
+        new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, type(spec)()))
+        for name in fields:  # a field missing from an older spec had its default
             stored = old.get(name, defaults[name])
             if stored != new[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",
                     asdict(spec)[name],
-                    f"the same {name} as the sweep stored there ({stored!r}), "
-                    "or a new --out folder, or --overwrite to start that sweep over",
+                    f"the same {name} as the run stored there ({stored!r}), "
+                    "or a new --out folder, or --overwrite to start that run over",
                 )
     if not os.path.lexists(jobs_path):
         return {}
-    return _read_jobs(jobs_path)
+    return _read_jobs(jobs_path, _parse_record if sweep_records else _parse_keyed)
 
 
-def _read_spec(path: Path) -> dict:
-    """The stored specification (a JSON object with SweepSpec's fields)."""
+def _read_spec(path: Path, kind: type = SweepSpec) -> dict:
+    """The stored specification (a JSON object with ``kind``'s fields)."""
     try:
         old = json.loads(path.read_bytes().decode("utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
@@ -389,7 +413,7 @@ def _read_spec(path: Path) -> dict:
         raise ResultFolderError(
             path, f"is not a sweep specification rsg sweep wrote ({reason})", START_OVER
         ) from None
-    known = set(asdict(SweepSpec()))
+    known = set(asdict(kind()))
     if not isinstance(old, dict) or "model" not in old or not set(old) <= known:
         raise ResultFolderError(
             path, "is not a sweep specification rsg sweep wrote (other fields)", START_OVER
@@ -397,7 +421,7 @@ def _read_spec(path: Path) -> dict:
     return old
 
 
-def _read_jobs(path: Path) -> dict[str, dict]:
+def _read_jobs(path: Path, parse: Callable[[bytes], tuple[dict | None, str]]) -> dict[str, dict]:
     """The records of ``jobs.jsonl``; an unfinished last line (no newline: the sweep was
     killed while writing it) is dropped from the file, with a note on stderr."""
     try:
@@ -410,14 +434,14 @@ def _read_jobs(path: Path) -> dict[str, dict]:
     for number, line in enumerate(complete, start=1):
         if not line.strip():
             continue
-        record, problem = _parse_record(line)
+        record, problem = parse(line)
         if record is None:
             raise ResultFolderError(
                 path, f"line {number} is not a job record of rsg sweep ({problem})", START_OVER
             )
         finished[record["key"]] = record
     if last.strip():
-        record, _ = _parse_record(last)
+        record, _ = parse(last)
         if record is not None:
             finished[record["key"]] = record
             keep = len(data)
@@ -439,6 +463,17 @@ def _read_jobs(path: Path) -> dict[str, dict]:
                 path, f"cannot be repaired ({exc.strerror})", START_OVER
             ) from exc
     return finished
+
+
+def _parse_keyed(line: bytes) -> tuple[dict | None, str]:
+    """(record, "") for a JSON object with a string ``key``, else (None, what is wrong)."""
+    try:
+        record = json.loads(line.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        return None, type(exc).__name__
+    if not isinstance(record, dict) or not isinstance(record.get("key"), str):
+        return None, "not a JSON object with a key"
+    return record, ""
 
 
 def _parse_record(line: bytes) -> tuple[dict | None, str]:
@@ -490,54 +525,102 @@ def run_sweep(
     workers: int = 1,
     backend: str = "process",
     progress: bool = True,
+    jobs: list[Job] | None = None,
+    label: str = "sweep",
     overwrite: bool = False,
 ) -> list[dict]:
-    """Run (or resume) the sweep into ``out``; returns the records of all its jobs.
+    """Run (or resume) the sweep into ``out``; returns the records of all its jobs
+    (``jobs``, default :func:`all_jobs`; ``label`` names the progress bar).
 
-    Args:
-        spec, out, workers, backend, progress: What to sweep, where, how.
-        overwrite: Delete the sweep (and any other ``rsg`` results) in ``out`` first.
+    Raises:
+        ParameterError: Bad workers/backend or a mismatching folder.
+        RsgError: The folder cannot be written.
+    """
+    jobs = all_jobs(spec) if jobs is None else jobs
+    arguments = {job.key: (spec, job) for job in jobs}
+    finished = run_resumable(
+        _run_job_args,
+        arguments,
+        out,
+        spec,
+        RESULT_FIELDS,
+        SPEC_FILE,
+        workers,
+        backend,
+        progress,
+        label,
+        overwrite=overwrite,
+    )
+    return [finished[job.key] for job in jobs]
+
+
+def run_resumable(
+    function: Callable[[T], dict],
+    arguments: dict[str, T],
+    out: Path,
+    spec: Any,
+    fields: tuple[str, ...],
+    spec_file: str,
+    workers: int,
+    backend: str,
+    progress: bool,
+    label: str = "sweep",
+    unit: str = "jobs",
+    overwrite: bool = False,
+) -> dict[str, dict]:
+    """The records of ``function`` over ``arguments`` (key -> argument; each record
+    carries its ``key``), run in ``workers`` or taken from ``out``'s ``jobs.jsonl``:
+    each new record is appended there as soon as it is done, and ``spec`` is stored in
+    ``spec_file`` (:func:`load_finished` checks ``fields`` on a resume). ``progress``:
+    a bar labelled ``label`` counting ``unit`` on stderr.
+
+    ``label`` is also the command whose files of :data:`app.result_folder.RESULT_FILES`
+    are resumed; ``overwrite`` deletes them (and any other ``rsg`` results) first.
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
         RsgError: The folder cannot be written, or holds files that are not this
-            sweep's (:func:`app.result_folder.prepare_out`, :func:`load_finished`).
+            command's (:func:`app.result_folder.prepare_out`, :func:`load_finished`).
     """
     check_workers(workers, backend)
     if backend not in ("process", "ray"):
         raise ParameterError("--backend", backend, "process or ray")
-    own = () if overwrite else RESULT_FILES["sweep"]
-    for path in prepare_out(out, "sweep", overwrite, resumable=own):
+    own = () if overwrite else RESULT_FILES[label]
+    for path in prepare_out(out, label, overwrite, resumable=own):
         if progress:
             print(f"deleted {path} (--overwrite)", file=sys.stderr)
-    finished = load_finished(out, spec)
     try:
-        (out / SPEC_FILE).write_text(json.dumps(asdict(spec), indent=2) + "\n")
+        out.mkdir(parents=True, exist_ok=True)
+        finished = load_finished(out, spec, spec_file, fields, function is _run_job_args)
+        (out / spec_file).write_text(json.dumps(asdict(spec), indent=2) + "\n")
     except OSError as exc:
-        raise RsgError(f"cannot write the sweep to {out}: {exc}") from exc
-    jobs = all_jobs(spec)
-    todo = [job for job in jobs if job.key not in finished]
+        raise RsgError(f"cannot write the results to {out}: {exc}") from exc
+    todo = [argument for key, argument in arguments.items() if key not in finished]
     workers = min(workers, max(len(todo), 1))
-    bar = JobProgress(len(jobs), len(jobs) - len(todo), progress)
+    bar = JobProgress(len(arguments), len(arguments) - len(todo), progress, label, unit)
     with (out / JOBS_FILE).open("a") as sink:
-        for record in _execute(spec, todo, workers, backend):
+        for _, record in run_jobs(function, todo, workers, backend):
             sink.write(json.dumps(record) + "\n")
             sink.flush()
             finished[record["key"]] = record
             bar.advance()
-    return [finished[job.key] for job in jobs]
+    return finished
 
 
-def _execute(spec: SweepSpec, jobs: list[Job], workers: int, backend: str) -> Iterable[dict]:
-    if not jobs:
+def run_jobs(
+    function: Callable[[T], R], arguments: list[T], workers: int, backend: str = "process"
+) -> Iterator[tuple[T, R]]:
+    """(argument, result) of ``function`` for each argument, in the order they finish,
+    in worker processes (:func:`run_in_processes`) or as Ray tasks (``backend="ray"``,
+    :func:`app.sweep_ray.run_on_ray`)."""
+    if not arguments:
         return
     if backend == "ray":
-        from .sweep_ray import execute_on_ray
+        from .sweep_ray import run_on_ray
 
-        yield from execute_on_ray(spec, jobs, workers)
+        yield from run_on_ray(function, arguments, workers)
         return
-    for _, record in run_in_processes(_run_job_args, [(spec, job) for job in jobs], workers):
-        yield record
+    yield from run_in_processes(function, arguments, workers)
 
 
 def run_in_processes(

@@ -1,4 +1,4 @@
-"""Polar plot of a sweep's envelope: one curve per controller and the capturability bound."""
+"""Polar plot of a sweep's envelope: one curve per controller and the capture bound."""
 
 from __future__ import annotations
 
@@ -47,7 +47,7 @@ def plot_envelope(envelope: dict, path: Path) -> Path:
             angles = [math.radians(r["direction_deg"]) for r in rows_]
             if not bound_drawn:
                 ax.plot(*_closed(angles, [r["bound"] for r in rows_]), "k--", lw=1.5,
-                        label="capturability bound")  # fmt: skip
+                        label="capture bound")  # fmt: skip
                 bound_drawn = True
             ax.plot(*_closed(angles, [r["impulse"] for r in rows_]), "o-", ms=3,
                     color=COLORS.get(controller), label=controller)  # fmt: skip

@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import math
 
+from planner.exceptions import RsgError
 from planner.parameters import PlannerConfig
 from planner.types import Push
 
@@ -18,6 +19,31 @@ def push_timing(config: PlannerConfig, cycle: int, phase: float) -> tuple[float,
     sigma = 1 if cycle % 2 == 0 else -1
     since_step = phase * gait.step_duration
     return step_time + since_step, sigma, since_step
+
+
+def measured_touchdown(runner, backend, config, initial, cycle: int, **options) -> float:  # noqa: ANN001
+    """Time [s] at which nominal step ``cycle`` lands in the unpushed walk of ``runner``
+    (:func:`app.runner.run_closed_loop` or a backend's own) on ``backend``.
+
+    The nominal t_k of :func:`push_timing` is where the reference enters D_S; the loop
+    steps at the first tick inside it, so each step lands up to two control periods
+    after its nominal time and the delays add up (G1 in PyBullet, 10 ms ticks: step 4
+    at 3.17 s instead of 3.1 s). A push timed from this touchdown hits the same point
+    of the gait on every model, as IHMC's tests trigger on the gait state.
+
+    Raises:
+        RsgError: The walk fell or did not take ``cycle`` steps.
+    """
+    gait = config.gait
+    nominal = gait.single_support_duration + (cycle - 1) * gait.step_duration
+    scenario = Scenario("walk", nominal + gait.step_duration / 2)
+    result = runner(backend, config, scenario, initial, qp_solver="exact", **options)
+    if result.fall.fell or len(result.steps) < cycle:
+        raise RsgError(
+            f"the unpushed walk took {len(result.steps)} steps by {scenario.duration:g} s "
+            f"(fell: {result.fall.reason or 'no'}): no touchdown of step {cycle} to time the push"
+        )
+    return float(result.steps[cycle - 1].event["t"])
 
 
 class SettledTrial:

@@ -36,6 +36,7 @@ import pinocchio
 import placo
 from numpy.typing import NDArray
 
+from kinematics.native_output import native_output_silenced
 from planner.exceptions import ParameterError, RsgError
 from robots.description import RobotDescription
 from robots.urdf_cache import FOOT_FRAMES, TRUNK_FRAME, derived_urdf
@@ -82,6 +83,17 @@ def kinematic_urdf_text(description: RobotDescription) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def humanoid_robot(description: RobotDescription) -> Any:
+    """placo's ``HumanoidRobot`` of the robot (kinematic URDF, no collisions).
+
+    Its constructor's warnings about Sigmaban-only frames are silenced
+    (:mod:`kinematics.native_output`).
+    """
+    text = kinematic_urdf_text(description)
+    with native_output_silenced():
+        return placo.HumanoidRobot("", placo.Flags.ignore_collisions, text)
+
+
 def yaw_rotation(yaw: float) -> NDArray[np.float64]:
     """Rotation matrix about the world z axis by ``yaw`` [rad]."""
     c, s = np.cos(yaw), np.sin(yaw)
@@ -123,9 +135,7 @@ class WholeBodyIK:
                 ``upper_body_offsets``.
         """
         self.description = description
-        self.robot = placo.HumanoidRobot(
-            "", placo.Flags.ignore_collisions, kinematic_urdf_text(description)
-        )
+        self.robot = humanoid_robot(description)
         self.joint_names: list[str] = list(self.robot.joint_names())
         unknown = set(description.standing_posture) - set(self.joint_names)
         if unknown:

@@ -78,10 +78,15 @@ class LyapunovDesign:
 
     def level_set(self, level: float, count: int = 100) -> np.ndarray:
         """Points e_u on {V_u = level}, shape (count, 2) [m]."""
-        angles = np.linspace(0.0, 2.0 * math.pi, count)
-        circle = np.stack([np.cos(angles), np.sin(angles)], axis=1)
-        chol = np.linalg.cholesky(np.linalg.inv(self.matrix))
-        return math.sqrt(max(level, 0.0)) * circle @ chol.T
+        return level_set(self.matrix, level, count)
+
+
+def level_set(matrix: np.ndarray, level: float, count: int = 100) -> np.ndarray:
+    """Points e_u on {e_u^T P_u e_u = level} of a 2x2 P_u, shape (count, 2) [m], closed."""
+    angles = np.linspace(0.0, 2.0 * math.pi, count)
+    circle = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    chol = np.linalg.cholesky(np.linalg.inv(np.asarray(matrix, dtype=float)))
+    return math.sqrt(max(level, 0.0)) * circle @ chol.T
 
 
 def design_lyapunov(

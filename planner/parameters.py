@@ -261,6 +261,11 @@ class RsgParameters:
             sole's centre line at least this far outside the DCM predicted at the
             step, sigma+ (xi_dcm,y - u_d,y) <= -dcm_inset (see
             :mod:`planner.step_qp`); None (the paper): no such row.
+        qp_at_timing_jump: An extension of the output map H_nu: a timing jump (D_T)
+            steps where the QP (27) puts it even when V_u < gamma_v (a jump from D_T,2,
+            or a decision kept through ``step_reaction_time``); False (the paper):
+            below gamma_v H_nu steps 2 xi1*; with a reaction time the announced
+            foothold then moves between the QP's and 2 xi1* as V_u crosses gamma_v.
     """
 
     filter_time_constant: float = 0.05
@@ -277,11 +282,17 @@ class RsgParameters:
     push_cmp_threshold: float = 0.02
     reanchor_time: float = 0.0
     dcm_inset: float | None = None
+    qp_at_timing_jump: bool = True
 
     def __post_init__(self) -> None:
+        if not isinstance(self.qp_at_timing_jump, bool):
+            raise ParameterError("qp_at_timing_jump", self.qp_at_timing_jump, "True or False")
         if self.dcm_inset is not None:
             _check_ranges(self, "dcm_inset")
-        _check_ranges(self, *(f.name for f in fields(self) if f.name != "dcm_inset"))
+        _check_ranges(
+            self,
+            *(f.name for f in fields(self) if f.name not in ("dcm_inset", "qp_at_timing_jump")),
+        )
 
 
 CONTROLLERS = ("rsg", "fixed-timing", "no-step")

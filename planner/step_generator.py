@@ -29,7 +29,12 @@ Two departures from the paper, both documented in the README:
 D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
 early step the reference may reach D_S sooner, before a real swing foot could land.
 
-A documented extension (``RsgParameters.push_hold_time``; 0 restores the paper's
+Documented extensions, each off under the paper's rules (``app.setup.PAPER_RULES``):
+``push_hold_time``, ``step_reaction_time`` (below) and ``qp_at_timing_jump``: H_nu
+takes the QP's step for a timing jump even below gamma_v (a jump from D_T,2 with
+V_u < gamma_v; a decision kept through the reaction time); the paper steps 2 xi1*.
+
+The first (``RsgParameters.push_hold_time``; 0 restores the paper's
 D_T exactly):
 
 - Push hold. D_T,1 is held back while a push is measured, for at most
@@ -263,11 +268,13 @@ class ReactiveStepGenerator:
     ) -> tuple[np.ndarray, bool, bool]:
         """u_d of the output map H_nu; returns (u_d, from_qp, qp_feasible).
 
-        The QP is used while V_u >= gamma_v and for a scheduled timing jump;
-        ``xi`` is the state (c_H - o_H, cdot_H) at the step and ``reference_xi1``
-        xi1* then (default: now).
+        The QP is used while V_u >= gamma_v, and for a scheduled timing jump with
+        ``qp_at_timing_jump`` (the paper's H_nu: 2 xi1* below gamma_v); ``xi`` is the
+        state (c_H - o_H, cdot_H) at the step and ``reference_xi1`` xi1* then (default:
+        now).
         """
-        use_qp = level >= self.design.threshold or self.scheduled_step is not None
+        timing_jump = self.scheduled_step is not None and self.config.rsg.qp_at_timing_jump
+        use_qp = level >= self.design.threshold or timing_jump
         if self.config.adjusts_location and use_qp:
             problem = build_step_qp(
                 self.design.matrix,

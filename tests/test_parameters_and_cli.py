@@ -203,3 +203,20 @@ def test_a_robot_run_records_its_physics_model_and_real_time_factor(tmp_path) ->
     assert summary["real_time_factor"] > 0.0
     assert summary["locked_joints"] == list(get_robot("g1").locked_joints)
     assert summary["parameters"]["dcm_inset"] == 0.02
+
+
+def test_paper_rules_are_one_list_that_the_help_shows(capsys) -> None:
+    """--paper-rules sets every extension of app.setup.PAPER_RULES to its paper value,
+    and each command's help names each of them."""
+    from app.setup import PAPER_RULES, paper_rules
+
+    config = paper_rules(PlannerConfig())
+    for extension in PAPER_RULES:
+        owner = config.rsg if hasattr(config.rsg, extension.field) else config.constraints
+        assert getattr(owner, extension.field) == extension.paper_value, extension
+    for command in ("run", "sweep", "grid"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        text = " ".join(capsys.readouterr().out.split())
+        for extension in PAPER_RULES:
+            assert f"{extension.field}={extension.paper_value}" in text, (command, extension)

@@ -1,8 +1,13 @@
-"""The browser demo in real headless Chromium (``pytest -m browser -o addopts=""``).
+"""The browser pages in real headless Chromium (``pytest -m browser -o addopts=""``).
 
 Needs Debian's ``chromium`` (/usr/bin/chromium) and the Python ``playwright`` package;
-the tests are skipped without them. Software WebGL renders at about 1 frame/s, so the
-waits are generous.
+the tests are skipped without them. Software WebGL draws the G1 at about one frame
+per second, so the waits are generous. Buttons are clicked with the mouse where they
+are, as a user clicks (Playwright's ``locator.click`` first waits for two still
+animation frames, many seconds here).
+
+The pictures of the README are taken here: docs/demo_screenshot.png (LIPM page),
+docs/demo_screenshot_g1.png (G1 page) and docs/replay_screenshot_g1.png (replay).
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ import sys
 import tempfile
 import threading
 import time
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -28,6 +34,7 @@ ROOT = Path(__file__).resolve().parents[1]
 CHROMIUM = "/usr/bin/chromium"
 SCREENSHOT = ROOT / "docs" / "demo_screenshot.png"
 ROBOT_SCREENSHOT = ROOT / "docs" / "demo_screenshot_g1.png"
+REPLAY_SCREENSHOT = ROOT / "docs" / "replay_screenshot_g1.png"
 CHROMIUM_FLAGS = [
     "--headless",
     "--no-sandbox",
@@ -40,30 +47,21 @@ CHROMIUM_FLAGS = [
 ]
 PUSH_LINE = re.compile(r"^push t=(\d+\.\d+) s impulse=\((-?\d+\.\d+), (-?\d+\.\d+)\) N s duration=")
 ADJUSTED_LINE = re.compile(r"^step t=(\d+\.\d+) s foot=(left|right) .* adjusted=yes")
+GROUND_TOLERANCE = 4  # [px] ~1.5 cm at the side view's distance
+PANEL_LEFT = 860  # [px] the GUI panel covers the canvas right of this (1280 px wide)
 
 
-class DemoProcess:
-    """``rsg demo`` in a subprocess; its stdout lines are collected in the background."""
+class ServerProcess:
+    """``rsg ARGS --port P`` in a subprocess; its stdout lines are collected."""
 
-    def __init__(self, model: str, frame_rate: float = 40.0) -> None:
+    def __init__(self, *args: str) -> None:
         with socket.socket() as probe:
             probe.bind(("127.0.0.1", 0))
             self.port = probe.getsockname()[1]
         self.url = f"http://127.0.0.1:{self.port}"
         self.lines: list[str] = []
         self.proc = subprocess.Popen(
-            [
-                sys.executable,
-                "-m",
-                "app",
-                "demo",
-                "--model",
-                model,
-                "--port",
-                str(self.port),
-                "--frame-rate",
-                str(frame_rate),
-            ],
+            [sys.executable, "-m", "app", *args, "--port", str(self.port)],
             cwd=ROOT,
             stdout=subprocess.PIPE,
             stderr=subprocess.STDOUT,
@@ -116,6 +114,21 @@ def playwright_api():
         yield api
 
 
+@pytest.fixture
+def serve() -> Iterator:
+    servers: list[ServerProcess] = []
+
+    def start(*args: str) -> ServerProcess:
+        server = ServerProcess(*args)
+        servers.append(server)
+        server.wait_for_line("open http://", timeout=180)
+        return server
+
+    yield start
+    for server in servers:
+        assert server.stop() == 0, server.output()
+
+
 def open_page(api, url: str, profile: str):
     context = api.chromium.launch_persistent_context(
         profile,
@@ -131,6 +144,39 @@ def open_page(api, url: str, profile: str):
     return context, page
 
 
+def click(page, locator) -> None:
+    """A mouse click at the centre of ``locator`` (scrolled into view first)."""
+    locator.evaluate("element => element.scrollIntoView({block: 'center'})")
+    box = locator.bounding_box()
+    assert box is not None
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+
+
+def button(page, name: str):
+    return page.get_by_role("button", name=name, exact=True)
+
+
+def _input_xpath(label: str) -> str:
+    return (
+        f"//label[normalize-space()='{label}']/ancestor::div[1]/following-sibling::div"
+        "//input[not(@type='hidden')]"
+    )
+
+
+def field(page, label: str):
+    """The input of the GUI field labelled ``label``."""
+    return page.locator(f"xpath={_input_xpath(label)}").first
+
+
+def wait_for_value(page, label: str, value: str, timeout_ms: int = 30_000) -> None:
+    """Wait until the field labelled ``label`` shows ``value``."""
+    script = (
+        f'() => document.evaluate("{_input_xpath(label)}", document, null, 9, null)'
+        f".singleNodeValue.value === {value!r}"
+    )
+    page.wait_for_function(script, timeout=timeout_ms)
+
+
 def canvas_pixels(page) -> np.ndarray:
     import matplotlib.image as mpimg
 
@@ -140,9 +186,9 @@ def canvas_pixels(page) -> np.ndarray:
 
 def dismiss_notifications(page) -> None:
     """Close viser's notifications (e.g. "software WebGL") so they do not hide the view."""
-    for button in page.locator(".mantine-Notification-closeButton").all():
+    for close in page.locator(".mantine-Notification-closeButton").all():
         try:
-            button.click(timeout=5_000)
+            click(page, close)
         except Exception:  # noqa: BLE001 - purely cosmetic
             pass
 
@@ -151,115 +197,203 @@ def wait_for_status(page, text: str, timeout_ms: int = 120_000) -> None:
     page.get_by_text(re.compile(text)).first.wait_for(state="visible", timeout=timeout_ms)
 
 
-@pytest.fixture
-def demo_factory() -> Iterator:
-    demos: list[DemoProcess] = []
+def project(point: np.ndarray, width: int, height: int) -> tuple[float, float]:
+    """(column, row) [px] of ``point`` [m] (relative to the stance ankle) in the side view."""
+    from web.page import SIDE_VIEW_DISTANCE, SIDE_VIEW_FOV, SIDE_VIEW_HEIGHT, SIDE_VIEW_LOOK_HEIGHT
 
-    def start(model: str, frame_rate: float = 40.0) -> DemoProcess:
-        demo = DemoProcess(model, frame_rate)
-        demos.append(demo)
-        demo.wait_for_line("open http://", timeout=180)
-        return demo
+    camera = np.array([0.0, -SIDE_VIEW_DISTANCE, SIDE_VIEW_HEIGHT])
+    forward = np.array([0.0, 0.0, SIDE_VIEW_LOOK_HEIGHT]) - camera
+    forward /= np.linalg.norm(forward)
+    right = np.cross(forward, [0.0, 0.0, 1.0])
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    focal = (height / 2.0) / np.tan(SIDE_VIEW_FOV / 2.0)
+    v = np.asarray(point, float) - camera
+    depth = v @ forward
+    return width / 2.0 + focal * (v @ right) / depth, height / 2.0 - focal * (v @ up) / depth
 
-    yield start
-    for demo in demos:
-        assert demo.stop() == 0, demo.output()
+
+def check_robot_on_its_feet(page) -> float:
+    """From the side view (the page must be paused): the lowest pixel of the robot, in
+    the columns of the stance sole, is on the ground line under that sole, and no
+    pixel of the robot is below the ground. Returns the ground's row [px]."""
+    from robots import get_robot
+
+    sole = get_robot("g1").sole
+    click(page, button(page, "Side view"))
+    page.wait_for_timeout(10_000)  # the camera moves, a frame or two render
+    dismiss_notifications(page)
+    shown = canvas_pixels(page)
+    checkbox = field(page, "Robot")
+    click(page, checkbox)
+    page.wait_for_timeout(8_000)
+    hidden = canvas_pixels(page)
+    click(page, checkbox)
+    robot = np.abs(shown - hidden).max(axis=2) > 40.0  # pixels the robot covers
+    height, width = robot.shape
+    robot[:, PANEL_LEFT:] = False  # the panel lies over the canvas there (its checkbox)
+    assert robot.sum() > 2000, "the robot is not drawn"
+    corners = [
+        project(np.array([x, y, 0.0]), width, height)
+        for x in (sole.x_min, sole.x_max)
+        for y in (-sole.half_width, sole.half_width)
+    ]
+    columns = [c for c, _ in corners]
+    ground = [r for _, r in corners]  # rows of the ground under the sole
+    band = robot[:, int(np.floor(min(columns))) : int(np.ceil(max(columns))) + 1]
+    rows = np.nonzero(band.any(axis=1))[0]
+    assert len(rows), "no robot pixel above the stance sole"
+    lowest = rows.max()
+    message = f"lowest robot row {lowest} px, ground under the sole {min(ground):.1f}-"
+    message += f"{max(ground):.1f} px"
+    assert min(ground) - GROUND_TOLERANCE <= lowest <= max(ground) + GROUND_TOLERANCE, message
+    below = np.nonzero(robot.any(axis=1))[0].max()
+    assert below <= max(ground) + GROUND_TOLERANCE, f"robot drawn below the ground: row {below}"
+    return max(ground)
 
 
 # Robot mass [kg] per model: the page's presets are the paper's impulses x mass / 60 kg.
 MODEL_MASS = {"pybullet": 33.341, "lipm": 60.0}
 
 
-@pytest.mark.parametrize(
-    "model,frame_rate",
-    # Software-WebGL Chromium draws the G1 at ~1 frame/s; at 40 scene updates/s its
-    # message queue grows and clicks are answered late, so that page runs at 4 Hz.
-    [("lipm", 40.0), ("pybullet", 4.0)],
-)
-def test_push_from_page_gives_adjusted_step(playwright_api, demo_factory, model, frame_rate):
-    demo = demo_factory(model, frame_rate)
+def push_until_adjusted(page, demo: ServerProcess, model: str) -> None:
+    """Press Push (the paper's first push) until a push is followed by an adjusted step:
+    whether a push needs one depends on the gait phase it hits; at most 4 times."""
+    for _attempt in range(4):
+        before = len(demo.lines)
+        click(page, button(page, "Push"))
+        index, push = demo.wait_for_line(PUSH_LINE, timeout=60, start=before)
+        assert "source=page" in demo.lines[index]
+        impulse = np.array([float(push.group(2)), float(push.group(3))])
+        expected = np.array([8.0, -6.0]) * MODEL_MASS[model] / 60.0  # the first preset
+        np.testing.assert_allclose(impulse, expected, atol=0.06)
+        push_time = float(push.group(1))
+        try:
+            _, found = demo.wait_for_line(ADJUSTED_LINE, timeout=15, start=index)
+        except AssertionError:
+            continue
+        if push_time <= float(found.group(1)) <= push_time + 2.0:
+            return
+    raise AssertionError("no adjusted step after a push:\n" + demo.output())
+
+
+def test_lipm_page_push_fields_aim_pause_and_reset(playwright_api, serve):
+    demo = serve("demo", "--model", "lipm")
     with tempfile.TemporaryDirectory() as profile:
         context, page = open_page(playwright_api, demo.url, profile)
         try:
             wait_for_status(page, r"t = \d+\.\d+ s")
             wait_for_status(page, "running")
-            page.wait_for_timeout(3000 if model == "lipm" else 15_000)  # let it render
-            if model == "pybullet":
-                # The G1 meshes take ~30 s to load in software WebGL, while the walk
-                # started with the server: restart it so the push meets a walking robot.
-                before = len(demo.lines)
-                page.get_by_role("button", name="Reset", exact=True).click()
-                demo.wait_for_line(r"^reset", timeout=120, start=before)
-                page.wait_for_timeout(3000)
-            # Whether a push needs an adjusted step depends on the gait phase it hits
-            # (a few phases keep V_u low enough): push again, at most 4 times.
-            step = None
-            for _attempt in range(4):
-                before = len(demo.lines)
-                page.get_by_role("button", name="Push", exact=True).click()
-                index, push = demo.wait_for_line(PUSH_LINE, timeout=60, start=before)
-                assert "source=page" in demo.lines[index]
-                impulse = np.array([float(push.group(2)), float(push.group(3))])
-                expected = np.array([8.0, -6.0]) * MODEL_MASS[model] / 60.0  # paper preset
-                np.testing.assert_allclose(impulse, expected, atol=0.06)
-                push_time = float(push.group(1))
-                try:
-                    _, found = demo.wait_for_line(ADJUSTED_LINE, timeout=15, start=index)
-                except AssertionError:
-                    continue
-                if float(found.group(1)) <= push_time + 2.0:
-                    step = found
-                    break
-            assert step is not None, "no adjusted step after a push:\n" + demo.output()
-            assert float(step.group(1)) >= push_time
-            if model == "pybullet":
-                # The G1 may fall after the push: the page shows it; check it renders.
-                page.wait_for_timeout(4000)
-                pixels = canvas_pixels(page)
-                assert pixels.mean(axis=2).var() > 100.0, "the 3-D view looks blank"
-                return
-            page.get_by_role("button", name="Pause", exact=True).click()
+            page.wait_for_timeout(3000)
+            # Fields: what is typed is read once the user stops typing; the field then
+            # shows the value that will be used, and bad text is refused visibly.
+            impulse = field(page, "Impulse [N s]")
+            used = impulse.input_value()
+            impulse.fill("")
+            wait_for_value(page, "Impulse [N s]", used)
+            wait_for_status(page, r"impulse: empty; using " + re.escape(used) + " N s")
+            direction = field(page, "Direction [deg]")
+            direction.fill("720")
+            wait_for_value(page, "Direction [deg]", "0")
+            impulse.fill("0")
+            page.wait_for_timeout(3000)
+            before = len(demo.lines)
+            click(page, button(page, "Push"))
+            demo.wait_for_line(r"^push refused: impulse 0 N s", timeout=30, start=before)
+            assert not any(line.startswith("push t=") for line in demo.lines[before:])
+            # The paper's first push, typed in: applied, followed by an adjusted step.
+            direction.fill("-36.87")
+            impulse.fill("10")
+            page.wait_for_timeout(3000)
+            push_until_adjusted(page, demo, "lipm")
+            click(page, button(page, "Pause"))
             wait_for_status(page, "paused")
             wait_for_status(page, r"pushes [1-4] ")
             dismiss_notifications(page)
             page.wait_for_timeout(4000)  # a few frames with the adjusted (red) step
             pixels = canvas_pixels(page)
-            if model == "lipm":  # the G1 picture comes from the page-load test
-                page.screenshot(path=str(SCREENSHOT))
             assert pixels.mean(axis=2).var() > 100.0, "the 3-D view looks blank"
-
+            page.screenshot(path=str(SCREENSHOT))
             # A click on the ground aims the push from the robot towards the point.
-            canvas = page.locator("canvas").first
-            box = canvas.bounding_box()
+            box = page.locator("canvas").first.bounding_box()
             assert box is not None
             before = len(demo.lines)
             page.mouse.click(box["x"] + 0.25 * box["width"], box["y"] + 0.8 * box["height"])
             demo.wait_for_line(r"^aim direction=-?\d+ deg", timeout=60, start=before)
-
             before = len(demo.lines)
-            page.get_by_role("button", name="Reset", exact=True).click()
+            click(page, button(page, "Reset"))
             demo.wait_for_line(r"^reset", timeout=60, start=before)
             wait_for_status(page, "pushes 0")
         finally:
             context.close()
 
 
-def test_robot_page_loads_with_pybullet(playwright_api, demo_factory):
-    demo = demo_factory("pybullet")
+def test_g1_page_robot_on_its_feet_and_a_push(playwright_api, serve):
+    demo = serve("demo")
     with tempfile.TemporaryDirectory() as profile:
         context, page = open_page(playwright_api, demo.url, profile)
         try:
             wait_for_status(page, "pybullet g1")
-            page.wait_for_timeout(15_000)  # meshes load and render at ~1 frame/s
-            pixels = canvas_pixels(page).mean(axis=2)
-            assert pixels.var() > 100.0, "the 3-D view looks blank"
-            assert (pixels < 100.0).mean() > 0.002, "no robot-sized dark region rendered"
-            # Restart so the README picture shows the robot walking, whatever the
-            # page's load time was.
-            page.get_by_role("button", name="Reset", exact=True).click()
-            wait_for_status(page, r"t = [2-9]\.\d+ s")
+            wait_for_status(page, "running")
+            page.wait_for_timeout(30_000)  # the meshes load and render at ~1 frame/s
+            # The walk started with the server: restart it so the push meets a walking robot.
+            before = len(demo.lines)
+            click(page, button(page, "Reset"))
+            demo.wait_for_line(r"^reset", timeout=120, start=before)
+            page.wait_for_timeout(3000)
+            push_until_adjusted(page, demo, "pybullet")
+            click(page, button(page, "Reset"))
+            wait_for_status(page, r"t = [3-9]\.\d+ s")
             dismiss_notifications(page)
-            page.wait_for_timeout(5000)
+            page.wait_for_timeout(4000)
+            pixels = canvas_pixels(page)
+            assert pixels.var() > 100.0, "the 3-D view looks blank"
             page.screenshot(path=str(ROBOT_SCREENSHOT))
+            click(page, button(page, "Pause"))
+            wait_for_status(page, "paused")
+            check_robot_on_its_feet(page)
+        finally:
+            context.close()
+
+
+def test_replay_page_of_a_g1_run_scrubs_and_plays(playwright_api, serve, tmp_path):
+    run = subprocess.run(
+        [sys.executable, "-m", "app", "run", "--scenario", "paper-fig6", "--duration", "6",
+         "--no-plots", "--quiet", "--out", str(tmp_path)],
+        cwd=ROOT, capture_output=True, text=True, timeout=600,
+    )  # fmt: skip
+    assert run.returncode in (0, 1), run.stderr
+    replay = serve("replay", str(tmp_path))
+    with urllib.request.urlopen(replay.url, timeout=30) as response:
+        assert response.status == 200
+    with tempfile.TemporaryDirectory() as profile:
+        context, page = open_page(playwright_api, replay.url, profile)
+        try:
+            wait_for_status(page, r"t = 0\.00 s")
+            page.wait_for_timeout(30_000)  # the meshes load
+            time_field = field(page, "Time [s]")
+            time_field.fill("3.85")  # the paper's first push acts (3.8 s to 3.9 s)
+            time_field.press("Enter")
+            wait_for_status(page, r"t = 3\.85 s")
+            wait_for_status(page, "pushes 1 of 2")
+            dismiss_notifications(page)
+            page.wait_for_timeout(6000)
+            page.screenshot(path=str(REPLAY_SCREENSHOT))
+            shown = canvas_pixels(page)[:, :PANEL_LEFT]
+            red = (shown[..., 0] > 150) & (shown[..., 1] < 110) & (shown[..., 2] < 110)
+            assert red.sum() > 100, "no push arrow while the push acts"  # shaded red
+            click(page, button(page, "Play"))
+            wait_for_status(page, "playing")
+            # It plays to the end of the run (5.99 s) and stops there.
+            wait_for_status(page, r"t = 5\.99 s of 5\.99 · paused", timeout_ms=60_000)
+            time_field.fill("4.35")  # mid-swing after the push
+            time_field.press("Enter")
+            wait_for_status(page, r"t = 4\.35 s")
+            ground = check_robot_on_its_feet(page)
+            # No push arrow once the push is over (the side view sees the arrow at the
+            # CoM's height, above the footholds, which may be red: adjusted steps).
+            later = canvas_pixels(page)[: int(ground) - 20, :PANEL_LEFT]
+            red = (later[..., 0] > 150) & (later[..., 1] < 110) & (later[..., 2] < 110)
+            assert red.sum() < 20, "a push arrow after the push"
         finally:
             context.close()

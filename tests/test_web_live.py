@@ -7,8 +7,8 @@ import time
 
 import pytest
 
-from web.live import LiveSimulation
-from web.scene_model import paper_presets
+from web.live import STEP_MARKS, LiveSimulation
+from web.push_input import PushInput, paper_presets
 
 
 def wait_for(condition, timeout: float = 20.0) -> bool:
@@ -106,3 +106,55 @@ def test_demo_stops_cleanly_on_a_signal_even_if_started_with_sigint_ignored(sign
             demo.wait(10)
     reader.join(5)
     assert any("rsg demo: stopped" in line for line in lines), lines
+
+
+def test_a_push_into_a_run_that_is_not_advancing_or_without_impulse_is_refused():
+    lines: list[str] = []
+    live = LiveSimulation("lipm", None, "rsg", "walk", log=lines.append)
+    live.start()
+    try:
+        preset = next(iter(paper_presets(live.snapshot().mass).values()))
+        assert wait_for(lambda: live.snapshot().status.time > 0.2)
+        live.set_paused(True)
+        assert wait_for(lambda: live.snapshot().status.paused)
+        live.request_push(preset)
+        assert wait_for(lambda: any("push refused: the run is paused" in line for line in lines))
+        live.set_paused(False)
+        assert wait_for(lambda: not live.snapshot().status.paused)
+        live.request_push(PushInput(preset.direction, 0.0, preset.duration))
+        assert wait_for(lambda: any("a push needs an impulse > 0" in line for line in lines))
+        assert not any(line.startswith("push t=") for line in lines)
+        assert live.snapshot().pushes_applied == 0
+        live.request_push(preset)
+        assert wait_for(lambda: any(line.startswith("push t=") for line in lines))
+        assert wait_for(lambda: live.snapshot().pushes_applied == 1)
+    finally:
+        live.stop()
+
+
+def test_the_live_loop_keeps_bounded_memory_however_long_it_runs():
+    """No time limit: the loop records no time series, and past pushes are dropped
+    (the live thread is driven tick by tick here, 14 s of walking with 7 pushes)."""
+    live = LiveSimulation("lipm", None, "rsg", "walk", log=lambda _: None)
+    loop = live._require_loop()
+    preset = next(iter(paper_presets(live.snapshot().mass).values()))
+    small = PushInput(preset.direction, 0.2 * preset.impulse, preset.duration)
+    sizes = []
+    for second in range(14):
+        if second % 2 == 0:
+            live.request_push(small)
+            live._handle_requests()
+        for _ in range(round(1.0 / loop.period)):
+            live._tick()
+        if second in (10, 13):
+            snap = live._make_snapshot()
+            assert snap.state is not None
+            sizes.append(
+                (len(loop.rows), len(loop.steps), len(loop.scenario.pushes),
+                 len(snap.state.steps), len(snap.plot_time), len(snap.state.com_trail))
+            )  # fmt: skip
+    assert live.snapshot().status.error == "" and not loop.backend.fall_status().fell
+    assert sizes[0][:3] == sizes[1][:3] == (1, 0, 1), sizes  # no time series, one push
+    assert sizes[0][4:] == sizes[1][4:] == (1000, 200), sizes  # plot and trail windows
+    assert sizes[1][3] <= STEP_MARKS
+    live.stop()

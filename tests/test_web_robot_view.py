@@ -1,4 +1,5 @@
-"""The robot view poses the URDF meshes like viser's own ``update_cfg`` (no browser)."""
+"""The robot is drawn where the simulation has it: the scene's transforms, composed
+like the browser composes them, put the soles and the pelvis on the simulated ones."""
 
 from __future__ import annotations
 
@@ -8,29 +9,103 @@ import numpy as np
 import pytest
 
 viser = pytest.importorskip("viser")
+from viser import transforms as tf  # noqa: E402
+
+WORLD_SHIFT = np.array([-0.4, 0.15, 0.0])  # [m] the page shifts /world to follow the robot
+POSITION_TOLERANCE = 0.005  # [m]
+ANGLE_TOLERANCE = np.radians(0.5)  # [rad]
 
 
-def test_closed_form_joint_rotations_match_update_cfg():
-    from robots import get_robot
-    from robots.urdf_cache import derived_urdf
-    from web.robot_view import RobotView
+def world_poses(nodes: dict) -> dict[str, np.ndarray]:
+    """4x4 pose in the scene of every node, composed from the root through the parent
+    names (viser: ``/a/b`` is a child of ``/a``), with each node's position and wxyz."""
+    poses: dict[str, np.ndarray] = {}
 
+    def pose(name: str) -> np.ndarray:
+        if name not in poses:
+            handle = nodes[name]
+            local = np.eye(4)
+            local[:3, :3] = tf.SO3(np.asarray(handle.wxyz, float)).as_matrix()
+            local[:3, 3] = handle.position
+            parent = name.rsplit("/", 1)[0]
+            poses[name] = (pose(parent) if parent else np.eye(4)) @ local
+        return poses[name]
+
+    for name in nodes:
+        pose(name)
+    return poses
+
+
+def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(a.T @ b) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+@pytest.fixture(scope="module")
+def server():
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
     server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    yield server
+    server.stop()
+
+
+def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
+    """Standing, mid-swing of each foot and after a push: every drawn sole within 5 mm
+    and 0.5 deg of the simulation's sole frame, the pelvis within 5 mm of the
+    simulated base, and the drawn stance foot's lowest vertex on the ground."""
+    from app.runner import ClosedLoop
+    from app.scenarios import Scenario
+    from app.setup import build_backend
+    from planner.types import Push
+    from robots.urdf_cache import derived_urdf
+    from web.robot_view import RobotView
+
+    backend, config, initial = build_backend("pybullet", "g1", "rsg")
+    push = Push(1.5, np.array([0.0, 4.0]), 0.1)
+    loop = ClosedLoop(backend, config, Scenario("walk", 3.0, (push,)), initial)
+    world = server.scene.add_frame("/world", show_axes=False, position=WORLD_SHIFT)
+    view = RobotView(server, derived_urdf(backend.description), "/world/robot")
+    assert len(view.joint_names) == 29
+    nodes = {"/world": world, **view.nodes}
+    ankle_meshes = {
+        foot: [n for n in view.nodes if n.startswith(view.link_nodes[link] + "/visual")]
+        for foot, link in (("left", "left_ankle_roll_link"), ("right", "right_ankle_roll_link"))
+    }
+    swing_heights = []
     try:
-        view = RobotView(server, derived_urdf(get_robot("g1")), "/world/robot")
-        assert len(view.joint_names) == 29
-        rng = np.random.default_rng(1)
-        joints = {name: float(rng.uniform(-0.8, 0.8)) for name in view.joint_names}
-        view.update(np.array([0.1, 0.2, 0.7]), np.array([1.0, 0.0, 0.0, 0.0]), joints)
-        frames = [frame for _, frame in view._moving]
-        ours = np.array([frame.wxyz for frame in frames])
-        view.urdf.update_cfg(np.array([joints[name] for name in view.joint_names]))
-        reference = np.array([frame.wxyz for frame in frames])
-        sign = np.sign(np.sum(ours * reference, axis=1))[:, None]  # q and -q: same rotation
-        np.testing.assert_allclose(ours * sign, reference, atol=1e-12)
-        np.testing.assert_allclose(view.base.position, [0.1, 0.2, 0.7])
+        for time in (0.0, 0.35, 1.15, 1.65):  # start, mid-swing right, mid-swing left, pushed
+            while loop.time < time - 1e-9:
+                loop.tick()
+            position, quaternion_xyzw, joints = backend.robot_configuration()
+            x, y, z, w = quaternion_xyzw
+            view.update(position, np.array([w, x, y, z]), joints)
+            poses = world_poses(nodes)
+            case = f"t={time} s"
+            pelvis = poses[view.link_nodes["pelvis"]]
+            np.testing.assert_allclose(
+                pelvis[:3, 3], position + WORLD_SHIFT, atol=POSITION_TOLERANCE, err_msg=case
+            )
+            heights = {}
+            for foot, frame in (("left", "left_foot"), ("right", "right_foot")):
+                sole_position, sole_rotation = backend.sim.sole_frame(foot)
+                drawn = poses[view.link_nodes[frame]]
+                np.testing.assert_allclose(
+                    drawn[:3, 3],
+                    sole_position + WORLD_SHIFT,
+                    atol=POSITION_TOLERANCE,
+                    err_msg=f"{case} {foot} sole",
+                )
+                assert rotation_angle(drawn[:3, :3], sole_rotation) < ANGLE_TOLERANCE, case
+                heights[foot] = sole_position[2]
+                lowest = min(
+                    float(np.min((poses[m][:3, :3] @ view.nodes[m].vertices.T)[2] + poses[m][2, 3]))
+                    for m in ankle_meshes[foot]
+                )
+                if sole_position[2] < 0.005:  # on the ground: its drawn foot too
+                    assert abs(lowest) < POSITION_TOLERANCE, f"{case} {foot}: lowest {lowest}"
+            swing_heights.append(max(heights.values()))
     finally:
-        server.stop()
+        backend.close()
+        world.remove()
+    assert swing_heights[1] > 0.02 and swing_heights[2] > 0.02, swing_heights  # mid-swing

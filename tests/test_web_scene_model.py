@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from planner.lyapunov import design_lyapunov
 from planner.parameters import PlannerConfig
+from web.push_input import PushBounds, clamp_push, paper_presets, wrap_degrees
 from web.scene_model import (
     ADJUSTED_COLOUR,
     NEXT_COLOUR,
@@ -16,29 +16,18 @@ from web.scene_model import (
     STANCE_COLOUR,
     TRAIL_COLOUR,
     ControllerState,
-    EuPanel,
-    PushBounds,
     StepMark,
     Trail,
-    clamp_push,
     direction_towards,
     draw_scene,
-    paper_presets,
     polyline_segments,
     push_arrow,
     ray_ground_intersection,
     rectangle,
-    wrap_degrees,
 )
 
 FOOT_LOWER = np.array([-0.09, -0.08])
 FOOT_UPPER = np.array([0.13, 0.08])
-
-
-@pytest.fixture(scope="module")
-def design():
-    config = PlannerConfig()
-    return design_lyapunov(config.model, config.constraints, config.rsg)
 
 
 def make_state(**changes) -> ControllerState:
@@ -78,10 +67,9 @@ def make_state(**changes) -> ControllerState:
 
 
 # ----------------------------------------------------------------------------- drawing
-def test_footholds_roles_colours_and_adjusted_steps(design):
+def test_footholds_roles_colours_and_adjusted_steps():
     state = make_state()
-    panel = EuPanel.fitting(design.level_set, design.threshold)
-    drawing = draw_scene(state, design.level_set, panel, FOOT_LOWER, FOOT_UPPER)
+    drawing = draw_scene(state, FOOT_LOWER, FOOT_UPPER)
     roles = [(f.role, f.colour) for f in drawing.footholds]
     assert roles == [
         ("trail", TRAIL_COLOUR),
@@ -111,21 +99,19 @@ def test_trail_of_steps_is_bounded():
     assert all((f.colour == ADJUSTED_COLOUR) == f.adjusted for f in trail)
 
 
-def test_window_rectangle_moves_with_window_center(design):
-    panel = EuPanel.fitting(design.level_set, design.threshold)
+def test_window_rectangle_moves_with_window_center():
     for center in ([0.0, 0.0], [1.3, -0.4]):
         state = make_state(window_center=np.array(center))
-        window = draw_scene(state, design.level_set, panel, FOOT_LOWER, FOOT_UPPER).window
+        window = draw_scene(state, FOOT_LOWER, FOOT_UPPER).window
         assert window.shape == (5, 2)
         np.testing.assert_allclose(window[0], window[-1])  # closed
         np.testing.assert_allclose(window.min(axis=0), np.array(center) + state.window_min)
         np.testing.assert_allclose(window.max(axis=0), np.array(center) + state.window_max)
 
 
-def test_points_trails_and_push_arrow(design):
+def test_points_trails_and_push_arrow():
     state = make_state()
-    panel = EuPanel.fitting(design.level_set, design.threshold)
-    drawing = draw_scene(state, design.level_set, panel, FOOT_LOWER, FOOT_UPPER)
+    drawing = draw_scene(state, FOOT_LOWER, FOOT_UPPER)
     np.testing.assert_allclose(drawing.com, [1.0, 0.02, state.com_height])
     np.testing.assert_allclose(drawing.zmp, [1.02, 0.09, 0.0])
     np.testing.assert_allclose(drawing.dcm[:2], state.com + state.com_velocity / state.omega)
@@ -134,17 +120,7 @@ def test_points_trails_and_push_arrow(design):
     np.testing.assert_allclose(end, drawing.com)  # the arrow ends at the CoM
     direction = (end - start)[:2] / np.linalg.norm(end - start)
     np.testing.assert_allclose(direction, [0.8, -0.6], atol=1e-12)
-    assert drawing.above_threshold
-    assert (
-        draw_scene(
-            make_state(push_impulse=None, lyapunov=0.001),
-            design.level_set,
-            panel,
-            FOOT_LOWER,
-            FOOT_UPPER,
-        ).push_arrow
-        is None
-    )
+    assert draw_scene(make_state(push_impulse=None), FOOT_LOWER, FOOT_UPPER).push_arrow is None
 
 
 def test_push_arrow_length_is_bounded():
@@ -155,29 +131,6 @@ def test_push_arrow_length_is_bounded():
     assert np.linalg.norm(short[1] - short[0]) < np.linalg.norm(long[1] - long[0]) <= 0.8
     assert push_arrow(com, 0.8, np.zeros(2)) is None
     assert push_arrow(com, 0.8, np.array([np.nan, 1.0])) is None
-
-
-def test_dcm_error_panel_level_sets(design):
-    panel = EuPanel.fitting(design.level_set, design.threshold, half_size=0.35)
-    state = make_state(lyapunov=0.5 * design.threshold)
-    drawing = draw_scene(state, design.level_set, panel, FOOT_LOWER, FOOT_UPPER)
-    # {V_u = gamma_v} spans 40 % of the half size; points on it have V_u = gamma_v.
-    radius = np.linalg.norm(drawing.threshold_curve, axis=1).max()
-    assert radius == pytest.approx(0.4 * 0.35)
-    levels = [design.level(p / panel.scale) for p in drawing.threshold_curve]
-    np.testing.assert_allclose(levels, design.threshold, rtol=1e-9)
-    # The current level set lies inside the threshold one, scaled by sqrt(1/2).
-    ratio = np.linalg.norm(drawing.level_curve, axis=1).max() / radius
-    assert ratio == pytest.approx(math.sqrt(0.5))
-    np.testing.assert_allclose(drawing.dcm_error_point, state.dcm_error * panel.scale)
-    assert drawing.dcm_error_trail.shape == (3, 2)
-    assert not drawing.above_threshold
-
-
-def test_dcm_error_panel_clips_large_errors(design):
-    panel = EuPanel.fitting(design.level_set, design.threshold, half_size=0.35)
-    far = panel.to_panel(np.array([[10.0, -10.0]]))
-    np.testing.assert_allclose(far, [[0.35, -0.35]])
 
 
 def test_helpers_rectangle_and_segments():

@@ -17,8 +17,9 @@ examples:
   rsg demo --scenario paper-fig6           # the paper's two pushes, plus yours
 
 The page shows the robot, its footholds, the ZMP window, ZMP/CoM/DCM, the DCM error
-against the Lyapunov level sets, and plots of V_u and of the time since the last step.
-Push from the page (button "Push", click the ground to aim). Ctrl-C stops the server.
+against the Lyapunov level sets (Fig. 6(c)), V_u / gamma_v on a log axis and the time
+since the last step. Push from the page (button "Push", click the ground to aim). The
+run goes on until you stop the server with Ctrl-C.
 """
 
 
@@ -39,7 +40,7 @@ def _bounded(option: str, kind: type, low: float, high: float, unit: str):  # no
     return parse
 
 
-_port = _bounded("--port", int, 1, 65535, "(a TCP port)")
+PORT = _bounded("--port", int, 1, 65535, "(a TCP port)")
 _frame_rate = _bounded("--frame-rate", float, 1.0, 60.0, "[Hz]")
 
 
@@ -72,15 +73,18 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="built-in scenario name or .toml file; its pushes are applied too (default: walk)",
     )
     demo.add_argument(
-        "--host", default="127.0.0.1", help="address to serve on (default: 127.0.0.1)"
+        "--host",
+        default="127.0.0.1",
+        help="address to serve on (default: 127.0.0.1, this machine only; any other "
+        "address lets whoever reaches the port push the robot)",
     )
-    demo.add_argument("--port", type=_port, default=8080, help="port to serve on (default: 8080)")
+    demo.add_argument("--port", type=PORT, default=8080, help="port to serve on (default: 8080)")
     demo.add_argument(
         "--frame-rate",
         type=_frame_rate,
         default=40.0,
-        help="scene updates sent to the page per second, 1 to 60 (default: 40); lower it for "
-        "browsers without GPU rendering, which otherwise fall behind and answer clicks late",
+        help="scene updates sent to the page per second, 1 to 60 (default: 40); a browser "
+        "without GPU rendering draws fewer and answers a click within one of its frames",
     )
     return demo
 

@@ -17,7 +17,7 @@ import sys
 import threading
 import time as wallclock
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
@@ -29,103 +29,27 @@ from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
 
-from .scene_model import ControllerState, PushInput, StepMark, Trail
+from .push_input import PushInput, push_refusal
+from .scene_model import ControllerState, StepMark, Trail
+from .snapshot import (
+    DCM_ERROR_TRAIL_TIME,
+    FOOT_MARGIN,
+    PLOT_TIME,
+    TRAIL_TIME,
+    PageStatus,
+    RobotPose,
+    Snapshot,
+)
 from .worker import Worker
 
 Array = NDArray[np.float64]
 
-MAX_RUN_TIME = 300.0  # [s] simulated time after which a run stops (press reset)
-TRAIL_TIME = 2.0  # [s] length of the CoM / ZMP / DCM trails
-DCM_ERROR_TRAIL_TIME = 4.0  # [s] length of the e_u trail
-PLOT_TIME = 10.0  # [s] time window of the plots
 RECORD_PERIOD = 0.01  # [s] sampling period of trails and plots
 PUBLISH_PERIOD = 1.0 / 60.0  # [s] wall time between snapshots while running
 LAG_LIMIT = 0.25  # [s] simulated lag after which pacing restarts (machine too slow)
 SPEED_WINDOW = 1.0  # [s] wall time over which the speed is measured
 SLOW_MOTION_FACTORS = (1.0, 0.5, 0.25, 0.1)  # [-] simulated seconds per wall second
-FOOT_MARGIN = 0.01  # [m] drawn sole = ZMP window enlarged by this margin
-
-
-@dataclass(frozen=True)
-class RobotPose:
-    """Configuration of the full robot (PyBullet backend).
-
-    Attributes:
-        base_position: URDF base (pelvis) position [m], shape (3,).
-        base_wxyz: URDF base orientation, quaternion (w, x, y, z).
-        joints: Joint angles [rad] by joint name.
-    """
-
-    base_position: Array
-    base_wxyz: Array
-    joints: dict[str, float]
-
-
-@dataclass(frozen=True)
-class LiveStatus:
-    """What the status line shows.
-
-    Attributes:
-        time: Simulated time [s].
-        model: Backend (``lipm`` or ``pybullet``); robot: robot name.
-        controller: Step controller in the loop.
-        paused: Paused by the user.
-        slow_motion: Requested simulated seconds per wall second [-].
-        speed: Measured simulated seconds per wall second [-] (0 when stopped).
-        last_event: Last push, step, fall or reset, as printed.
-        fell: The robot has fallen; fall_reason: why.
-        busy: What the thread is doing instead of simulating (e.g. rebuilding), or "".
-        ended: The run reached :data:`MAX_RUN_TIME`.
-        error: The last error of the simulation, or "".
-    """
-
-    time: float = 0.0
-    model: str = ""
-    robot: str = ""
-    controller: str = ""
-    paused: bool = False
-    slow_motion: float = 1.0
-    speed: float = 0.0
-    last_event: str = ""
-    fell: bool = False
-    fall_reason: str = ""
-    busy: str = ""
-    ended: bool = False
-    error: str = ""
-
-
-@dataclass(frozen=True)
-class Snapshot:
-    """The latest state of the live simulation, immutable.
-
-    Attributes:
-        serial: Increases with every snapshot.
-        state: Controller state, or None before the first tick.
-        robot: Full-robot configuration, or None on the LIPM.
-        status: Status line content.
-        plot_time: Times [s] of the plot samples.
-        plot_lyapunov: V_u at those times.
-        plot_time_since_step: s~ [s] at those times.
-        level_set: Points of {V_u = level} for a level (the Lyapunov design's).
-        foot_lower, foot_upper: Sole corners around the ankle [m], shape (2,).
-        mass: Robot mass [kg].
-        pushes_applied: Number of pushes applied since the last reset.
-        adjusted_steps: Number of adjusted steps since the last reset.
-    """
-
-    serial: int
-    state: ControllerState | None
-    robot: RobotPose | None
-    status: LiveStatus
-    plot_time: Array = field(default_factory=lambda: np.zeros(0))
-    plot_lyapunov: Array = field(default_factory=lambda: np.zeros(0))
-    plot_time_since_step: Array = field(default_factory=lambda: np.zeros(0))
-    level_set: Callable[[float], Array] | None = None
-    foot_lower: Array = field(default_factory=lambda: np.array([-0.1, -0.05]))
-    foot_upper: Array = field(default_factory=lambda: np.array([0.1, 0.05]))
-    mass: float = 0.0
-    pushes_applied: int = 0
-    adjusted_steps: int = 0
+STEP_MARKS = 50  # past steps kept for the drawing
 
 
 def push_line(push: Push, source: str) -> str:
@@ -184,6 +108,7 @@ class LiveSimulation:
         self._busy = ""
         self._error = ""
         self._loop: ClosedLoop | None = None
+        self._closed = False
         self._build(controller)
         self._snapshot = self._make_snapshot()
 
@@ -200,7 +125,8 @@ class LiveSimulation:
     def stop(self, timeout: float = 5.0) -> None:
         """Stop the thread and release the backend."""
         self._worker.stop(timeout)
-        if self._loop is not None:
+        if self._loop is not None and not self._closed:
+            self._closed = True
             self._loop.backend.close()
 
     def snapshot(self) -> Snapshot:
@@ -246,7 +172,7 @@ class LiveSimulation:
             self._loop.backend.close()
         scenario, _ = self._scenario_source.scaled_to(backend.mass)
         self._scenario = scenario
-        self._loop = ClosedLoop(backend, config, scenario, initial)
+        self._loop = ClosedLoop(backend, config, scenario, initial, record=False)
         self._controller = controller
         self._config = config
         margin = np.array([FOOT_MARGIN, FOOT_MARGIN])
@@ -321,7 +247,6 @@ class LiveSimulation:
             or self._busy
             or self._error
             or self._require_loop().backend.fall_status().fell
-            or self._require_loop().time >= MAX_RUN_TIME
         )
 
     def _handle_requests(self) -> bool:
@@ -358,10 +283,20 @@ class LiveSimulation:
 
     def _apply_push(self, push_input: PushInput) -> None:
         loop = self._require_loop()
+        why = push_refusal(push_input)
         if loop.backend.fall_status().fell:
-            self._event("push ignored: the robot has fallen (reset first)")
+            why = "the robot has fallen (press Reset)"
+        elif self._paused:
+            why = "the run is paused (press Resume)"
+        elif self._error:
+            why = "the run has stopped (press Reset)"
+        if why:
+            self._event(f"push refused: {why}")
             return
         push = Push(loop.time, push_input.impulse_xy(), push_input.duration)
+        # Pushes that are over are dropped: a run without end keeps its list short.
+        ongoing = tuple(p for p in loop.scenario.pushes if p.time + p.duration > loop.time)
+        loop.scenario = replace(loop.scenario, pushes=ongoing)
         loop.add_push(push)
         self._pushes_applied += 1
         self._event(push_line(push, "page"))
@@ -398,7 +333,7 @@ class LiveSimulation:
                 out.step.time, out.step.foot, np.array(out.step.position), out.step.adjusted
             )
             self._steps.append(mark)
-            del self._steps[:-50]
+            del self._steps[:-STEP_MARKS]
             self._adjusted_steps += int(mark.adjusted)
             self._event(step_line(mark, out.step.lyapunov_before, out.step.lyapunov_after))
         if loop.ticks % self._record_every == 0:
@@ -425,7 +360,7 @@ class LiveSimulation:
     def _make_snapshot(self) -> Snapshot:
         loop = self._require_loop()
         fall = loop.backend.fall_status()
-        status = LiveStatus(
+        status = PageStatus(
             time=loop.time,
             model=self.model,
             robot=self.robot or "",
@@ -437,7 +372,6 @@ class LiveSimulation:
             fell=fall.fell,
             fall_reason=fall.reason,
             busy=self._busy,
-            ended=loop.time >= MAX_RUN_TIME,
             error=self._error,
         )
         self._serial += 1

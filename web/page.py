@@ -1,21 +1,27 @@
-"""The viser page of the browser demo: GUI, scene nodes, and the render thread.
+"""The page of a run on a viser server: 3-D view, legend, status line and plots.
 
-The page reads :meth:`web.live.LiveSimulation.snapshot`, turns it into a
-:class:`web.scene_model.SceneDrawing` and updates the scene nodes in one
-``server.atomic()`` block per frame (:data:`FRAME_RATE` Hz). GUI callbacks only send
-requests to the simulation thread, so nothing here waits for the simulation.
+:class:`PageView` is what the live demo (:mod:`web.demo_page`) and the replay
+(:mod:`web.replay_page`) share: given a :class:`web.snapshot.Snapshot` it updates
+the scene nodes in one ``server.atomic()`` block, and the plots at a lower rate:
 
-All GUI and scene nodes are server-wide: every browser tab sees the same
-simulation, and any tab can push, pause or reset it.
+- the legend at the top of the panel;
+- the 3-D view: robot (or the LIPM's CoM on a stick), footholds, ZMP window,
+  ZMP/CoM/DCM with trails, and the push arrow while a push acts;
+- the DCM error of the paper's Fig. 6(c) as a 2-D plot in metres with the level
+  sets V_u = gamma_v and V_u = current (:mod:`web.plots`);
+- V_u / gamma_v over the last 10 s on a log axis (1 = gamma_v, above it the RSG
+  adjusts the step), and the time since the last step.
 
 View: the scene root ``/world`` is shifted so that the robot stays near the origin
-of the view (the ground grid scrolls under it). The DCM-error panel (the paper's
-Fig. 6(c)) is a flat inset on the ground beside the robot, fixed in the view.
+of the view (the ground grid scrolls under it). "Side view" puts every browser's
+camera just above the ground, :data:`SIDE_VIEW_DISTANCE` to the right of the
+stance ankle, looking at the robot: the ground is seen edge-on, so a sole on the
+ground sits on the ground's line.
+All GUI and scene nodes are server-wide: every browser tab sees the same run.
 """
 
 from __future__ import annotations
 
-import threading
 import time as wallclock
 from collections.abc import Callable
 from pathlib import Path
@@ -25,236 +31,182 @@ import numpy as np
 import viser
 from numpy.typing import NDArray
 
-from planner.parameters import CONTROLLERS
-
-from .live import SLOW_MOTION_FACTORS, LiveSimulation, Snapshot
+from .plots import RATIO_FLOOR, DcmErrorPlot, log_axis_top, lyapunov_ratio
 from .robot_view import RobotView
 from .scene_model import (
+    ADJUSTED_COLOUR,
     COM_COLOUR,
     DCM_COLOUR,
-    EU_TRAIL_COLOUR,
-    LEVEL_COLOUR,
+    NEXT_COLOUR,
     PREVIEW_COLOUR,
+    PREVIOUS_COLOUR,
     PUSH_COLOUR,
-    THRESHOLD_COLOUR,
+    STANCE_COLOUR,
+    TRAIL_COLOUR,
     WINDOW_COLOUR,
     ZMP_COLOUR,
     Colour,
-    EuPanel,
-    PushBounds,
-    PushInput,
     SceneDrawing,
-    clamp_push,
-    direction_towards,
     draw_scene,
     follow,
     on_ground,
-    paper_presets,
     polyline_segments,
-    push_arrow,
-    ray_ground_intersection,
 )
-from .worker import Worker
+from .snapshot import Snapshot
 
 Array = NDArray[np.float64]
 
-FRAME_RATE = 40.0  # [Hz] scene updates while the simulation runs
-PLOT_RATE = 5.0  # [Hz] plot updates
-PANEL_ORIGIN = np.array([0.2, -1.0, 0.004])  # [m] e_u panel centre, in the view
-PANEL_HALF_SIZE = 0.35  # [m]
+STATUS_LINES = 4  # the status block's height [lines]
+PLOT_RATE = 5.0  # [Hz] uPlot updates
+IMAGE_RATE = 3.0  # [Hz] DCM-error plot updates (a matplotlib image, ~20 ms each)
 GRID_SIZE = 20.0  # [m]
 GRID_CELL = 0.25  # [m]
-CUSTOM = "custom"
-TIME_SCALES: dict = {"x": {"time": False}}  # plain seconds on the x axis
-SLOW_MOTION_LABELS = {
-    f"{f:g}x" + (" (real time)" if f == 1.0 else ""): f for f in SLOW_MOTION_FACTORS
-}
-LEGEND = """\
-<small>
-<b>Feet</b>: <span style="color:#1e6ee6">stance</span>, <span style="color:#787878">previous</span>,
-<span style="color:#14aa46">planned next step</span>, past steps (grey; <span
-style="color:#e11e1e">red: adjusted by the RSG</span>).
-<b>Points</b>: <span style="color:#c800c8">ZMP</span>, <span style="color:#141414">CoM</span>,
-<span style="color:#00aac8">DCM</span> with 2 s trails; <span style="color:#f59600">ZMP window
-W(r_H)</span>; push arrow red while it acts, light orange = aim.
-<b>e_u panel</b> (square beside the robot, Fig. 6(c)): DCM error e_u ×scale,
-<span style="color:#e11e1e">V_u = γ_v</span>, <span style="color:#1e6ee6">V_u = current
-level</span>, black = last 4 s of e_u. <b>Click the ground</b> to aim the push.
-</small>"""
+SIDE_VIEW_DISTANCE = 3.5  # [m] camera to stance ankle, along -y
+SIDE_VIEW_HEIGHT = 0.05  # [m] camera height above the ground: the ground is seen edge-on
+SIDE_VIEW_LOOK_HEIGHT = 0.6  # [m] height of the point looked at, above the stance ankle
+SIDE_VIEW_FOV = np.radians(45.0)  # [rad] vertical field of view
+TIME_AXIS: Any = {"time": False}  # plain seconds on the x axis (a uPlot scale)
 
 
-def _set_value(handle: Any, value: object) -> None:
-    """Set a GUI input's value (viser's setter, which mypy sees as read-only)."""
-    handle.value = value
+def _hex(colour: Colour) -> str:
+    return "#{:02x}{:02x}{:02x}".format(*colour)
+
+
+def _swatch(colour: Colour, text: str, shape: str = "■") -> str:
+    return f'<span style="color:{_hex(colour)}">{shape}</span>&nbsp;{text}'
+
+
+LEGEND = (
+    "<small>"
+    + "<br>".join(
+        (
+            "<b>Feet</b> "
+            + " ".join(
+                (
+                    _swatch(STANCE_COLOUR, "stance", "▭"),
+                    _swatch(PREVIOUS_COLOUR, "previous", "▭"),
+                    _swatch(NEXT_COLOUR, "next (planned)", "▭"),
+                    _swatch(TRAIL_COLOUR, "past", "▭"),
+                    _swatch(ADJUSTED_COLOUR, "adjusted by the RSG", "☒"),
+                )
+            ),
+            "<b>Points</b> "
+            + " ".join(
+                (
+                    _swatch(ZMP_COLOUR, "ZMP", "●"),
+                    _swatch(COM_COLOUR, "CoM", "●"),
+                    _swatch(DCM_COLOUR, "DCM", "●"),
+                    "(2 s trails)",
+                    _swatch(WINDOW_COLOUR, "ZMP window W(r_H)", "▭"),
+                )
+            ),
+            "<b>Push</b> "
+            + " ".join(
+                (
+                    _swatch(PUSH_COLOUR, "acting now", "➜"),
+                    _swatch(PREVIEW_COLOUR, "being aimed", "➜"),
+                )
+            ),
+        )
+    )
+    + "</small>"
+)
+
+
+def _status_html(lines: list[str]) -> str:
+    rows = "".join(
+        f'<div style="white-space:nowrap;overflow:hidden;text-overflow:ellipsis">{line}</div>'
+        for line in lines[:STATUS_LINES]
+    )
+    height = 1.45 * STATUS_LINES
+    return f'<div style="height:{height}em;line-height:1.45em;font-size:0.85em">{rows}</div>'
 
 
 def _colours(colour: Colour, count: int) -> NDArray[np.uint8]:
     return np.tile(np.array(colour, dtype=np.uint8), (count, 2, 1))
 
 
-class DemoPage:
-    """The demo's page on a viser server, driven by a live simulation.
+class PageView:
+    """The drawing of a run on a viser server.
 
     Args:
         server: The viser server.
-        live: The simulation to show and control.
         urdf: Derived URDF of the robot (absolute mesh paths) for the full robot, or
             None to draw the point-mass LIPM (CoM ball on a stick).
-        log: Called with a line when the user aims by clicking (default: print).
-        frame_rate: Scene updates per second while the simulation runs [Hz].
+        controls: Adds the page's own GUI (buttons, fields), placed between the
+            legend and the plots.
     """
 
     def __init__(
         self,
         server: viser.ViserServer,
-        live: LiveSimulation,
         urdf: Path | None,
-        log: Callable[[str], None] | None = None,
-        frame_rate: float = FRAME_RATE,
+        controls: Callable[[], None] | None = None,
     ) -> None:
         self.server = server
-        self.frame_rate = frame_rate
-        self._log = log or (lambda line: print(line, flush=True))
-        self.live = live
-        self._worker = Worker(self._run, "rsg-page")
-        self._offset = np.zeros(2)
-        self._last_serial = -1
+        self.offset = np.zeros(2)  # [m] world point shown at the view's origin
+        self._stance = np.zeros(2)  # [m] stance ankle, in the world
         self._last_plot = 0.0
-        self._dirty = True
-        self._frames: list[float] = []
-        self.update_rate = 0.0  # [Hz] scene updates over the last second
-        first = live.snapshot()
-        self._bounds = PushBounds.for_mass(first.mass)
-        self._presets = paper_presets(first.mass)
-        self._panel: EuPanel | None = None
+        self._last_image = 0.0
+        self._dcm_error_plot = DcmErrorPlot()
         server.scene.set_up_direction("+z")
         server.initial_camera.position = (-0.7, -2.1, 1.25)
         server.initial_camera.look_at = (0.3, -0.45, 0.4)
-        self._build_gui()
-        self._build_scene(urdf)
-        server.scene.on_click()(self._on_click)
-
-    # ------------------------------------------------------------------------- GUI
-    def _build_gui(self) -> None:
-        gui = self.server.gui
-        self.fall_alert = gui.add_markdown("", visible=False)
-        self.status = gui.add_markdown("starting ...")
-        self.reset_button = gui.add_button("Reset", hint="the robot stands again, the run restarts")
-        self.pause_button = gui.add_button("Pause")
-        with gui.add_folder("Push"):
-            first = next(iter(self._presets.values()))
-            self.preset = gui.add_dropdown("Preset", (*self._presets, CUSTOM), initial_value=CUSTOM)
-            self.direction = gui.add_slider(
-                "Direction [deg]", -180.0, 180.0, 1.0, round(first.direction)
-            )
-            self.impulse = gui.add_slider(
-                "Impulse [N s]",
-                0.0,
-                round(self._bounds.impulse_max, 1),
-                0.1,
-                round(first.impulse, 1),
-            )
-            self.duration = gui.add_slider(
-                "Duration [s]",
-                self._bounds.duration_min,
-                self._bounds.duration_max,
-                0.01,
-                first.duration,
-            )
-            self.push_button = gui.add_button("Push", color="red")
-            gui.add_markdown("<small>Click the ground to aim from the robot.</small>")
-        with gui.add_folder("Simulation"):
-            self.slow_motion = gui.add_dropdown(
-                "Slow motion",
-                tuple(SLOW_MOTION_LABELS),
-                initial_value=next(iter(SLOW_MOTION_LABELS)),
-            )
-            self.controller = gui.add_dropdown(
-                "Controller", CONTROLLERS, initial_value=self.live.controller
-            )
+        gui = server.gui
+        # A wider panel: the legend and the plots fit, no share button (local pages).
+        gui.configure_theme(control_width="large", show_share_button=False)
+        self.status = gui.add_html(_status_html(["starting ..."]))
+        gui.add_html(LEGEND)
+        if controls is not None:
+            controls()
         with gui.add_folder("Plots"):
+            self.dcm_error_image = gui.add_image(
+                self._dcm_error_plot.render(
+                    np.zeros(2), np.zeros((0, 2)), np.zeros((1, 2)), np.zeros((1, 2)), False
+                ),
+                format="png",
+            )
             zeros = np.zeros(2)
             self.lyapunov_plot = gui.add_uplot(
-                (zeros, zeros, zeros),
+                (zeros, zeros + 1e-3, zeros + 1.0),
                 (
                     {"label": "t [s]"},
-                    {"label": "V_u", "stroke": "#1e6ee6", "width": 2},
-                    {"label": "γ_v", "stroke": "#e11e1e", "dash": (6.0, 4.0)},
+                    {"label": "V_u/γ_v", "stroke": "#1e6ee6", "width": 2},
+                    {"label": "γ_v", "stroke": "#e11e1e", "dash": (6.0, 4.0), "width": 1.5},
                 ),
-                title="V_u(t) against γ_v",
-                scales=TIME_SCALES,
+                title="V_u / γ_v (log; above 1 the RSG adjusts the step)",
+                scales=self._lyapunov_scales(10.0),
+                padding=(12, 24, 0, 0),
                 aspect=1.6,
             )
+            self._lyapunov_top = 10.0
             self.since_step_plot = gui.add_uplot(
                 (zeros, zeros),
                 ({"label": "t [s]"}, {"label": "s~ [s]", "stroke": "#14aa46", "width": 2}),
-                title="time since the last step [s]",
-                scales=TIME_SCALES,
+                title="time since the last step s~ [s]",
+                scales={"x": TIME_AXIS},
                 aspect=1.6,
             )
-        with gui.add_folder("Legend", expand_by_default=False):
-            gui.add_html(LEGEND)
-
-        self.push_button.on_click(lambda _: self._push())
-        self.reset_button.on_click(lambda _: self.live.request_reset())
-        self.pause_button.on_click(lambda _: self._toggle_pause())
-        self.preset.on_update(lambda _: self._apply_preset())
-        for handle in (self.direction, self.impulse, self.duration):
-            handle.on_update(lambda _: self._mark_dirty())
-        self.slow_motion.on_update(
-            lambda _: self.live.set_slow_motion(SLOW_MOTION_LABELS[self.slow_motion.value])
-        )
-        self.controller.on_update(lambda _: self.live.request_controller(self.controller.value))
-
-    def push_input(self) -> PushInput:
-        """The push set in the GUI, clamped to the safe ranges."""
-        return clamp_push(
-            float(self.direction.value),
-            float(self.impulse.value),
-            float(self.duration.value),
-            self._bounds,
-        )
-
-    def _push(self) -> None:
-        self.live.request_push(self.push_input())
-
-    def _toggle_pause(self) -> None:
-        paused = not self.live.snapshot().status.paused
-        self.live.set_paused(paused)
-        self.pause_button.label = "Resume" if paused else "Pause"
-
-    def _apply_preset(self) -> None:
-        preset = self._presets.get(self.preset.value)
-        if preset is not None:
-            _set_value(self.direction, round(preset.direction))
-            _set_value(self.impulse, round(preset.impulse, 1))
-            _set_value(self.duration, preset.duration)
-        self._mark_dirty()
-
-    def _mark_dirty(self) -> None:
-        self._dirty = True
-
-    def _on_click(self, event: viser.SceneClickEvent) -> None:
-        point = ray_ground_intersection(event.ray_origin, event.ray_direction)
-        state = self.live.snapshot().state
-        if point is None or state is None:
-            return
-        direction = direction_towards(state.com, point + self._offset)
-        if direction is not None:
-            self._log(
-                f"aim direction={direction:.0f} deg towards ({point[0] + self._offset[0]:.2f}, "
-                f"{point[1] + self._offset[1]:.2f}) m"
+        with gui.add_folder("View"):
+            self.show_robot = gui.add_checkbox("Robot", True, hint="draw the robot's meshes")
+            self.side_view_button = gui.add_button(
+                "Side view", hint="camera level with the ground, beside the stance sole"
             )
-            _set_value(self.direction, round(direction))
-            _set_value(self.preset, CUSTOM)
-            self._mark_dirty()
+        self.show_robot.on_update(lambda _: self._show_robot())
+        self.side_view_button.on_click(lambda _: self.side_view())
+        self._build_scene(urdf)
 
     # ----------------------------------------------------------------------- scene
     def _build_scene(self, urdf: Path | None) -> None:
         scene = self.server.scene
         self.world = scene.add_frame("/world", show_axes=False)
         self.grid = scene.add_grid(
-            "/world/grid", GRID_SIZE, GRID_SIZE, cell_size=GRID_CELL, section_size=1.0
+            "/world/grid",
+            GRID_SIZE,
+            GRID_SIZE,
+            cell_size=GRID_CELL,
+            section_size=1.0,
+            shadow_opacity=0.0,
         )
         self.robot: RobotView | None = None
         if urdf is not None:
@@ -301,135 +253,98 @@ class DemoPage:
             shaft_radius=0.008,
             head_radius=0.025,
             head_length=0.05,
+            visible=False,
         )
         self.fall_label = scene.add_label(
             "/world/fall_label", "", visible=False, font_screen_scale=1.6, anchor="bottom-center"
         )
-        # The e_u panel, fixed in the view beside the robot.
-        panel = scene.add_frame("/eu_panel", show_axes=False, position=PANEL_ORIGIN)
-        del panel
-        h = PANEL_HALF_SIZE
-        border = np.array([[-h, -h], [h, -h], [h, h], [-h, h], [-h, -h]])
-        axes = np.array([[[-h, 0, 0], [h, 0, 0]], [[0, -h, 0], [0, h, 0]]])
-        scene.add_line_segments(
-            "/eu_panel/frame",
-            np.concatenate([polyline_segments(on_ground(border)), axes]),
-            (150, 150, 150),
-            thickness=0.004,
-        )
-        scene.add_label(
-            "/eu_panel/title",
-            "DCM error e_u (red: V_u = γ_v, blue: current V_u)",
-            position=(-h, h + 0.02, 0.0),
-            anchor="bottom-left",
-            font_screen_scale=0.8,
-        )
-        self.threshold_node = scene.add_line_segments(
-            "/eu_panel/threshold", np.zeros((1, 2, 3)), THRESHOLD_COLOUR, thickness=0.008
-        )
-        self.level_node = scene.add_line_segments(
-            "/eu_panel/level", np.zeros((1, 2, 3)), LEVEL_COLOUR, thickness=0.006
-        )
-        self.eu_trail_node = scene.add_line_segments(
-            "/eu_panel/trail", np.zeros((1, 2, 3)), EU_TRAIL_COLOUR, thickness=0.005
-        )
-        self.eu_point = scene.add_icosphere("/eu_panel/point", 0.02, EU_TRAIL_COLOUR)
 
-    # ---------------------------------------------------------------- render thread
-    def start(self) -> None:
-        """Start updating the page (idempotent)."""
-        self._worker.start()
+    def set_status(self, lines: list[str]) -> None:
+        """Show the status: up to :data:`STATUS_LINES` lines of HTML, each cut to one
+        line, in a block of fixed height (the controls below it never move)."""
+        self.status.content = _status_html(lines)
 
-    def stop(self, timeout: float = 5.0) -> None:
-        """Stop updating the page."""
-        self._worker.stop(timeout)
+    @staticmethod
+    def _lyapunov_scales(top: float) -> Any:
+        return {"x": TIME_AXIS, "y": {"distr": 3, "log": 10, "range": [RATIO_FLOOR, top]}}
 
-    def _run(self, stop: threading.Event) -> None:
-        period = 1.0 / self.frame_rate
-        last = wallclock.perf_counter()
-        while not stop.is_set():
-            start = wallclock.perf_counter()
-            snap = self.live.snapshot()
-            if snap.serial != self._last_serial or self._dirty:
-                self._dirty = False
-                self._last_serial = snap.serial
-                try:
-                    self.update(snap, start - last)
-                except Exception as exc:  # noqa: BLE001 - keep the page alive, say why
-                    self.status.content = f"page update failed: {exc!r}"
-                last = start
-                self._frames = [t for t in self._frames if t > start - 1.0] + [start]
-                self.update_rate = float(len(self._frames))
-            stop.wait(max(0.0, period - (wallclock.perf_counter() - start)))
+    def _show_robot(self) -> None:
+        if self.robot is not None:
+            self.robot.visible = bool(self.show_robot.value)
 
-    def update(self, snap: Snapshot, dt: float) -> None:
-        """Show ``snap`` (one atomic scene update; plots at :data:`PLOT_RATE`)."""
+    def side_view(self) -> None:
+        """Every browser's camera :data:`SIDE_VIEW_HEIGHT` above the ground,
+        :data:`SIDE_VIEW_DISTANCE` to the right of the stance ankle, looking at the point
+        :data:`SIDE_VIEW_LOOK_HEIGHT` above it (vertical field of view :data:`SIDE_VIEW_FOV`)."""
+        ankle = self._stance - self.offset
+        camera = np.array([ankle[0], ankle[1] - SIDE_VIEW_DISTANCE, SIDE_VIEW_HEIGHT])
+        target = np.array([ankle[0], ankle[1], SIDE_VIEW_LOOK_HEIGHT])
+        for client in self.server.get_clients().values():
+            client.camera.fov = float(SIDE_VIEW_FOV)
+            client.camera.up_direction = (0.0, 0.0, 1.0)
+            client.camera.position = camera
+            client.camera.look_at = target
+
+    # ---------------------------------------------------------------------- frames
+    def show(self, snap: Snapshot, dt: float, aim: Array | None = None) -> None:
+        """Draw ``snap``: one atomic scene update; plots at :data:`PLOT_RATE` and
+        :data:`IMAGE_RATE`.
+
+        Args:
+            snap: What to draw.
+            dt: Wall time since the last frame [s] (the view follows the robot).
+            aim: Arrow of the push being aimed (start, end) [m], shape (2, 3), or None.
+        """
         state = snap.state
         with self.server.atomic():
-            self._update_status(snap)
-            if state is not None and snap.level_set is not None:
-                if self._panel is None:
-                    self._panel = EuPanel.fitting(snap.level_set, state.threshold, PANEL_HALF_SIZE)
+            if state is not None:
+                self._stance = np.asarray(state.stance, float)
                 target = np.asarray(state.com, float)
-                jump = float(np.linalg.norm(target - self._offset)) > 2.0
-                self._offset = target if jump else follow(self._offset, target, dt)
-                self.world.position = (-self._offset[0], -self._offset[1], 0.0)
-                cell = np.round(self._offset / 1.0) * 1.0
+                jump = float(np.linalg.norm(target - self.offset)) > 2.0
+                self.offset = target if jump or dt <= 0.0 else follow(self.offset, target, dt)
+                self.world.position = (-self.offset[0], -self.offset[1], 0.0)
+                cell = np.round(self.offset / 1.0) * 1.0
                 self.grid.position = (cell[0], cell[1], 0.0)
-                drawing = draw_scene(
-                    state, snap.level_set, self._panel, snap.foot_lower, snap.foot_upper
-                )
-                self._update_drawing(drawing, state.stance)
-                self._update_aim(state.com, state.com_height, state.fell, drawing)
+                drawing = draw_scene(state, snap.foot_lower, snap.foot_upper)
+                self._draw(drawing, state.stance)
+                visible = aim is not None and drawing.push_arrow is None and not state.fell
+                if aim is not None and visible:
+                    self.aim_node.points = aim[None].astype(np.float32)
+                self.aim_node.visible = visible
                 self.fall_label.visible = state.fell
                 if state.fell:
-                    self.fall_label.text = f"FALLEN ({state.fall_reason}): press Reset"
+                    self.fall_label.text = f"FALLEN ({state.fall_reason})"
                     self.fall_label.position = (state.com[0], state.com[1], 1.2)
             if snap.robot is not None and self.robot is not None:
                 pose = snap.robot
                 self.robot.update(pose.base_position, pose.base_wxyz, pose.joints)
+        self._plot(snap)
+
+    def _plot(self, snap: Snapshot) -> None:
         now = wallclock.perf_counter()
+        state = snap.state
+        if state is None:
+            return
         if now - self._last_plot >= 1.0 / PLOT_RATE and len(snap.plot_time) >= 2:
             self._last_plot = now
-            threshold = state.threshold if state is not None else 0.0
-            self.lyapunov_plot.data = (
-                snap.plot_time,
-                snap.plot_lyapunov,
-                np.full_like(snap.plot_time, threshold),
-            )
+            ratio = lyapunov_ratio(snap.plot_lyapunov, state.threshold)
+            top = log_axis_top(float(ratio.max()))
+            if top != self._lyapunov_top:
+                self._lyapunov_top = top
+                self.lyapunov_plot.scales = self._lyapunov_scales(top)
+            self.lyapunov_plot.data = (snap.plot_time, ratio, np.ones_like(snap.plot_time))
             self.since_step_plot.data = (snap.plot_time, snap.plot_time_since_step)
-
-    def _update_status(self, snap: Snapshot) -> None:
-        s = snap.status
-        if s.error:
-            state = f"**stopped**: {s.error}. Press Reset."
-        elif s.busy:
-            state = f"**{s.busy} ...**"
-        elif s.fell:
-            state = "**FALLEN**"
-        elif s.ended:
-            state = "**run ended** (time limit): press Reset"
-        elif s.paused:
-            state = "**paused**"
-        else:
-            state = "running"
-        self.status.content = (
-            f"**t = {s.time:.2f} s** · {state} · controller **{s.controller}** · "
-            f"{s.model} {s.robot if s.model != 'lipm' else ''}  \n"
-            f"speed {s.speed:.2f}x real time (asked {s.slow_motion:g}x) · "
-            f"page {self.update_rate:.0f} Hz · pushes {snap.pushes_applied} · "
-            f"adjusted steps {snap.adjusted_steps}  \n"
-            f"<small>last event: {s.last_event or '-'}</small>"
-        )
-        self.fall_alert.visible = s.fell
-        if s.fell:
-            self.fall_alert.content = (
-                f"### The robot has fallen\n{s.fall_reason} at t = {s.time:.2f} s. "
-                "Press **Reset** to stand it up and restart."
+        if now - self._last_image >= 1.0 / IMAGE_RATE and snap.level_set is not None:
+            self._last_image = now
+            self.dcm_error_image.image = self._dcm_error_plot.render(
+                state.dcm_error,
+                state.dcm_error_trail,
+                snap.level_set(state.threshold),
+                snap.level_set(state.lyapunov),
+                state.lyapunov > state.threshold,
             )
-        self.pause_button.label = "Resume" if s.paused else "Pause"
 
-    def _update_drawing(self, drawing: SceneDrawing, stance: Array) -> None:
+    def _draw(self, drawing: SceneDrawing, stance: Array) -> None:
         segments, colours = [], []
         for foothold in drawing.footholds:
             z = 0.002 if foothold.role == "trail" else 0.004
@@ -463,18 +378,6 @@ class DemoPage:
         if drawing.push_arrow is not None:
             self.push_node.points = drawing.push_arrow[None].astype(np.float32)
         self.push_node.visible = drawing.push_arrow is not None
-        self._set_polyline(self.threshold_node, on_ground(drawing.threshold_curve))
-        self._set_polyline(self.level_node, on_ground(drawing.level_curve))
-        self._set_polyline(self.eu_trail_node, on_ground(drawing.dcm_error_trail))
-        self.eu_point.position = (*drawing.dcm_error_point, 0.01)
-        self.eu_point.color = THRESHOLD_COLOUR if drawing.above_threshold else EU_TRAIL_COLOUR
-
-    def _update_aim(self, com: Array, height: float, fell: bool, drawing: SceneDrawing) -> None:
-        aim = push_arrow(com, height, self.push_input().impulse_xy())
-        visible = aim is not None and drawing.push_arrow is None and not fell
-        if aim is not None and visible:
-            self.aim_node.points = aim[None].astype(np.float32)
-        self.aim_node.visible = visible
 
     @staticmethod
     def _set_polyline(node: viser.LineSegmentsHandle, points: Array) -> None:

@@ -1,30 +1,38 @@
 """The full robot on the page: URDF meshes posed from the simulated configuration.
 
-:class:`RobotView` loads the URDF with :class:`viser.extras.ViserUrdf` (meshes and one
-frame per joint) and poses it each frame. ``ViserUrdf.update_cfg`` recomputes every
-joint transform through yourdfpy's scene graph (about 12 ms for the G1, too slow
-for 30 Hz next to the simulation); here only the moving joints are updated, with
-their rotations computed in closed form (vectorised quaternions). Fixed joints keep
-the transforms ViserUrdf set when loading.
+:class:`RobotView` builds the robot's scene tree itself, with viser's public scene
+API: one frame per URDF link, nested like the kinematic tree (viser names nodes by
+path, ``/a/b`` is a child of ``/a``), each placed at its joint's origin when built,
+and the link's visual meshes under it. Posing the robot then writes the base pose
+and, for each moving joint, one quaternion: origin rotation times the rotation
+about the joint axis (the translation of a revolute joint never changes). The
+browser composes the tree, so every link is drawn where forward kinematics puts
+it. viser sends a pose only when it changed.
 
-This relies on ViserUrdf's joint-frame list (viser 1.1.1, pinned); on another
-version without it, the view falls back to ``update_cfg``.
+(viser's ``ViserUrdf`` recomputes every transform through yourdfpy's scene graph in
+``update_cfg``, about 12 ms a frame for the G1, and keeps its frames private.)
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import trimesh
 import viser
+import yourdfpy
 from numpy.typing import NDArray
 from viser import transforms as tf
-from viser.extras import ViserUrdf
+
+from planner.exceptions import ParameterError
 
 Array = NDArray[np.float64]
+DEFAULT_COLOUR = (180, 180, 180)  # links without a material colour
 
 
-def _quaternion_multiply(a: Array, b: Array) -> Array:
+def quaternion_multiply(a: Array, b: Array) -> Array:
     """Hamilton products of quaternions (w, x, y, z), row by row, shape (n, 4)."""
     aw, ax, ay, az = a.T
     bw, bx, by, bz = b.T
@@ -39,50 +47,148 @@ def _quaternion_multiply(a: Array, b: Array) -> Array:
     )
 
 
+@dataclass(frozen=True)
+class _MovingJoint:
+    name: str
+    frame: viser.FrameHandle
+    origin_wxyz: NDArray[np.floating]
+    axis: NDArray[np.floating]
+
+
+def _colour_of(visual: yourdfpy.Visual, materials: Mapping[str, Array]) -> tuple[int, int, int]:
+    material = visual.material
+    rgba = None
+    if material is not None:
+        if material.color is not None:
+            rgba = material.color.rgba
+        elif material.name in materials:
+            rgba = materials[material.name]
+    if rgba is None:
+        return DEFAULT_COLOUR
+    r, g, b = (int(round(255 * float(c))) for c in np.asarray(rgba)[:3])
+    return (r, g, b)
+
+
+def _visual_mesh(visual: yourdfpy.Visual, urdf: Path) -> trimesh.Trimesh | None:
+    """The visual's geometry in its link frame [m], or None if it has none."""
+    geometry = visual.geometry
+    if geometry.mesh is not None:
+        path = Path(geometry.mesh.filename)
+        loaded = trimesh.load(path if path.is_absolute() else urdf.parent / path, force="mesh")
+        if not isinstance(loaded, trimesh.Trimesh):
+            return None
+        mesh = loaded
+        if geometry.mesh.scale is not None:
+            mesh.apply_scale(geometry.mesh.scale)
+    elif geometry.box is not None:
+        mesh = trimesh.creation.box(extents=geometry.box.size)
+    elif geometry.cylinder is not None:
+        mesh = trimesh.creation.cylinder(geometry.cylinder.radius, geometry.cylinder.length)
+    elif geometry.sphere is not None:
+        mesh = trimesh.creation.icosphere(radius=geometry.sphere.radius)
+    else:
+        return None
+    if visual.origin is not None:
+        mesh.apply_transform(visual.origin)
+    return mesh
+
+
 class RobotView:
     """The robot's meshes under scene node ``root`` [m, rad].
 
     Args:
         server: The viser server.
         urdf: Path of the URDF (absolute mesh paths, e.g. the derived URDF).
-        root: Scene node of the robot's base (its pose is the base pose).
+        root: Scene node of the robot's base link (its pose is the base pose).
+
+    Attributes:
+        joint_names: Moving (revolute) joints, in URDF order.
+        nodes: Every scene node of the robot by name: link frames and meshes.
+        link_nodes: Scene node name of each URDF link.
+
+    Raises:
+        ParameterError: The URDF has a joint type other than fixed, revolute or
+            continuous.
     """
 
     def __init__(self, server: viser.ViserServer, urdf: Path, root: str) -> None:
-        self.base = server.scene.add_frame(root, show_axes=False)
-        self.urdf = ViserUrdf(server, urdf, root_node_name=root)
-        self.joint_names = self.urdf.get_actuated_joint_names()
-        frames = getattr(self.urdf, "_joint_frames", None)
-        joints = getattr(self.urdf, "_joint_map_values", None)
-        self._moving: list[tuple[int, viser.FrameHandle]] = []
-        origins, axes = [], []
-        if frames is not None and joints is not None and len(frames) == len(joints):
-            for joint, frame in zip(joints, frames, strict=True):
-                if joint.type not in ("revolute", "continuous") or joint.mimic is not None:
-                    if joint.type == "prismatic" or joint.mimic is not None:
-                        self._moving = []
-                        break  # not handled in closed form: use update_cfg
-                    continue
-                origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin)
-                origins.append(tf.SO3.from_matrix(origin[:3, :3]).wxyz)
-                axis = np.asarray(joint.axis, dtype=float)
-                axes.append(axis / np.linalg.norm(axis))
-                self._moving.append((self.joint_names.index(joint.name), frame))
-        self._origin_wxyz = np.array(origins).reshape(-1, 4)
-        self._axes = np.array(axes).reshape(-1, 3)
+        model = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False)
+        robot = model.robot
+        materials = {m.name: m.color.rgba for m in robot.materials if m.color is not None}
+        children: dict[str, list[yourdfpy.Joint]] = {}
+        for joint in robot.joints:
+            children.setdefault(joint.parent, []).append(joint)
+        child_links = {joint.child for joint in robot.joints}
+        base = next(link.name for link in robot.links if link.name not in child_links)
+        visuals = {link.name: link.visuals for link in robot.links}
 
-    def update(self, base_position: Array, base_wxyz: Array, joints: dict[str, float]) -> None:
-        """Pose the robot: base position [m], base quaternion (w, x, y, z), joint angles [rad]."""
+        scene = server.scene
+        self.base = scene.add_frame(root, show_axes=False)
+        self.nodes: dict[str, viser.SceneNodeHandle] = {root: self.base}
+        self.link_nodes: dict[str, str] = {base: root}
+        moving: list[_MovingJoint] = []
+        pending = [base]
+        while pending:
+            link = pending.pop()
+            for joint in children.get(link, []):
+                if joint.type not in ("fixed", "revolute", "continuous"):
+                    raise ParameterError(
+                        f"joint {joint.name} type", joint.type, "fixed, revolute or continuous"
+                    )
+                origin = np.eye(4) if joint.origin is None else np.asarray(joint.origin, float)
+                wxyz = tf.SO3.from_matrix(origin[:3, :3]).wxyz
+                name = f"{self.link_nodes[link]}/{joint.child}"
+                frame = scene.add_frame(name, show_axes=False, position=origin[:3, 3], wxyz=wxyz)
+                self.nodes[name] = frame
+                self.link_nodes[joint.child] = name
+                if joint.type != "fixed":
+                    axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
+                    moving.append(_MovingJoint(joint.name, frame, wxyz, axis))
+                pending.append(joint.child)
+        for link, node in self.link_nodes.items():
+            for index, visual in enumerate(visuals[link]):
+                mesh = _visual_mesh(visual, urdf)
+                if mesh is None:
+                    continue
+                mesh_name = f"{node}/visual_{index}"
+                self.nodes[mesh_name] = scene.add_mesh_simple(
+                    mesh_name,
+                    np.asarray(mesh.vertices, np.float32),
+                    np.asarray(mesh.faces, np.uint32),
+                    color=_colour_of(visual, materials),
+                    cast_shadow=False,
+                    receive_shadow=False,
+                )
+        order = {joint.name: index for index, joint in enumerate(robot.joints)}
+        moving.sort(key=lambda joint: order[joint.name])
+        self._moving = moving
+        self.joint_names = tuple(joint.name for joint in moving)
+        self._origin_wxyz = np.array([joint.origin_wxyz for joint in moving]).reshape(-1, 4)
+        self._axes = np.array([joint.axis for joint in moving]).reshape(-1, 3)
+
+    @property
+    def visible(self) -> bool:
+        """Whether the robot is drawn."""
+        return self.base.visible
+
+    @visible.setter
+    def visible(self, visible: bool) -> None:
+        self.base.visible = visible
+
+    def update(self, base_position: Array, base_wxyz: Array, joints: Mapping[str, float]) -> None:
+        """Pose the robot: base position [m], base quaternion (w, x, y, z), joint angles [rad].
+
+        Raises:
+            ParameterError: ``joints`` lacks a moving joint of the URDF.
+        """
+        try:
+            angles = np.array([joints[name] for name in self.joint_names], dtype=float)
+        except KeyError as missing:
+            raise ParameterError("joints", sorted(joints), f"every joint, {missing} too") from None
         self.base.position = base_position
         self.base.wxyz = base_wxyz
-        q = np.array([joints.get(name, 0.0) for name in self.joint_names])
-        if not self._moving:
-            self.urdf.update_cfg(q)
-            return
-        angles = q[[index for index, _ in self._moving]]
-        motion = np.concatenate(
-            [np.cos(angles / 2.0)[:, None], np.sin(angles / 2.0)[:, None] * self._axes], axis=1
-        )
-        wxyz = _quaternion_multiply(self._origin_wxyz, motion)
-        for (_, frame), rotation in zip(self._moving, wxyz, strict=True):
-            frame.wxyz = rotation
+        half = 0.5 * angles
+        motion = np.concatenate([np.cos(half)[:, None], np.sin(half)[:, None] * self._axes], axis=1)
+        wxyz = quaternion_multiply(self._origin_wxyz, motion)
+        for joint, rotation in zip(self._moving, wxyz, strict=True):
+            joint.frame.wxyz = rotation

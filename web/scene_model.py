@@ -4,12 +4,13 @@ Everything here is plain NumPy so it can be tested without a browser:
 
 - :class:`ControllerState`: one snapshot of the closed loop (CoM, ZMP, window
   centre r_H, footholds, DCM error e_u, Lyapunov level V_u, recent trails);
-- :func:`draw_scene`: what is drawn for it (:class:`SceneDrawing`): footholds with
-  their colours, the ZMP window W(r_H) as a rectangle, ZMP/CoM/DCM points and
-  trails, the push arrow, and the e_u panel (level sets of V_u and the e_u trail);
-- the push input (:class:`PushInput`, :class:`PushBounds`, :func:`clamp_push`,
-  :func:`paper_presets`) and the click on the ground
-  (:func:`ray_ground_intersection`, :func:`direction_towards`).
+- :func:`draw_scene`: what is drawn in the 3-D view for it (:class:`SceneDrawing`):
+  footholds with their colours, the ZMP window W(r_H) as a rectangle, ZMP/CoM/DCM
+  points and trails, and the push arrow while a push acts;
+- the click on the ground (:func:`ray_ground_intersection`, :func:`direction_towards`).
+
+The DCM-error plot and V_u(t) are drawn by :mod:`web.plots`; the push input is
+:mod:`web.push_input`.
 
 Frames: world frame, x forward, y left, z up [m]. Colours are RGB 0-255.
 """
@@ -17,7 +18,6 @@ Frames: world frame, x forward, y left, z up [m]. Colours are RGB 0-255.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,111 +43,7 @@ THRESHOLD_COLOUR: Colour = (225, 30, 30)  # {V_u = gamma_v}: red
 LEVEL_COLOUR: Colour = (30, 110, 230)  # {V_u = current level}: blue
 EU_TRAIL_COLOUR: Colour = (20, 20, 20)  # recent e_u: black
 
-REFERENCE_MASS = 60.0  # [kg] mass the paper's impulses are given for
-PAPER_PUSHES = (((8.0, -6.0), 0.1), ((-6.0, 8.0), 0.2))  # ([N s], [s]) for 60 kg
-MAX_IMPULSE_AT_REFERENCE = 30.0  # [N s] largest push offered, for 60 kg
-MIN_PUSH_DURATION = 0.05  # [s]
-MAX_PUSH_DURATION = 0.5  # [s]
 RAY_EPSILON = 1e-9  # [-] |ray z component| below which a ray is parallel to the ground
-
-
-# ----------------------------------------------------------------------------- push input
-@dataclass(frozen=True)
-class PushInput:
-    """A push as the user sets it.
-
-    Attributes:
-        direction: Direction of the impulse in the ground plane [deg], 0 = +x (forward),
-            90 = +y (left); in (-180, 180].
-        impulse: Magnitude of the impulse [N s], >= 0.
-        duration: Duration of the push [s], > 0.
-    """
-
-    direction: float
-    impulse: float
-    duration: float
-
-    def impulse_xy(self) -> Array:
-        """Impulse vector i_H [N s], shape (2,)."""
-        angle = math.radians(self.direction)
-        return self.impulse * np.array([math.cos(angle), math.sin(angle)])
-
-
-@dataclass(frozen=True)
-class PushBounds:
-    """Safe ranges of the push input for a robot.
-
-    Attributes:
-        impulse_max: Largest impulse [N s] (30 N s for 60 kg, scaled by mass / 60 kg).
-        duration_min: Shortest push [s].
-        duration_max: Longest push [s].
-    """
-
-    impulse_max: float
-    duration_min: float = MIN_PUSH_DURATION
-    duration_max: float = MAX_PUSH_DURATION
-
-    @staticmethod
-    def for_mass(mass: float) -> PushBounds:
-        """Bounds for a robot of ``mass`` [kg].
-
-        Raises:
-            ValueError: ``mass`` is not a finite number > 0.
-        """
-        if not (math.isfinite(mass) and mass > 0.0):
-            raise ValueError(f"robot mass {mass!r}: expected a finite number > 0 [kg]")
-        return PushBounds(MAX_IMPULSE_AT_REFERENCE * mass / REFERENCE_MASS)
-
-
-def wrap_degrees(angle: float) -> float:
-    """``angle`` [deg] wrapped to (-180, 180]."""
-    wrapped = math.fmod(angle, 360.0)
-    if wrapped <= -180.0:
-        wrapped += 360.0
-    elif wrapped > 180.0:
-        wrapped -= 360.0
-    return wrapped
-
-
-def clamp_push(direction: float, impulse: float, duration: float, bounds: PushBounds) -> PushInput:
-    """The push the user asked for, brought into the safe ranges.
-
-    The direction is wrapped to (-180, 180] deg, the impulse clipped to
-    [0, ``bounds.impulse_max``] N s and the duration to
-    [``bounds.duration_min``, ``bounds.duration_max``] s.
-
-    Raises:
-        ValueError: A value is not a finite number (names the field and the range).
-    """
-    values = {"direction [deg]": direction, "impulse [N s]": impulse, "duration [s]": duration}
-    for name, value in values.items():
-        if not isinstance(value, int | float) or not math.isfinite(value):
-            raise ValueError(f"push {name} {value!r}: expected a finite number")
-    return PushInput(
-        direction=wrap_degrees(float(direction)),
-        impulse=float(np.clip(impulse, 0.0, bounds.impulse_max)),
-        duration=float(np.clip(duration, bounds.duration_min, bounds.duration_max)),
-    )
-
-
-def paper_presets(mass: float) -> dict[str, PushInput]:
-    """The paper's pushes, (8,-6) N s over 0.1 s and (-6,8) N s over 0.2 s, for ``mass`` [kg].
-
-    Impulses scale with ``mass / 60 kg`` like the scenarios, so the velocity change is
-    the paper's.
-
-    Raises:
-        ValueError: ``mass`` is not a finite number > 0.
-    """
-    bounds = PushBounds.for_mass(mass)
-    presets = {}
-    for (ix, iy), duration in PAPER_PUSHES:
-        scale = mass / REFERENCE_MASS
-        label = f"paper ({ix:g},{iy:g}) N s, {duration:g} s"
-        presets[label] = clamp_push(
-            math.degrees(math.atan2(iy, ix)), math.hypot(ix, iy) * scale, duration, bounds
-        )
-    return presets
 
 
 # ------------------------------------------------------------------------ click on ground
@@ -334,39 +230,6 @@ class FootholdDrawing:
 
 
 @dataclass(frozen=True)
-class EuPanel:
-    """The DCM-error view (the paper's Fig. 6(c)) drawn as a flat inset in the scene.
-
-    e_u is drawn at ``scale`` times its size, in a square of half side ``half_size``
-    [m] whose centre is the panel's origin; points outside are clipped to its border.
-
-    Attributes:
-        half_size: Half side of the panel [m of scene].
-        scale: Scene metres per metre of e_u [-].
-    """
-
-    half_size: float
-    scale: float
-
-    @staticmethod
-    def fitting(level_set: Callable[[float], Array], threshold: float, half_size: float = 0.35):
-        """A panel where {V_u = ``threshold``} spans 40 % of the half size.
-
-        Args:
-            level_set: Points of {V_u = level} for a level (``LyapunovDesign.level_set``).
-            threshold: gamma_v.
-            half_size: Half side of the panel [m].
-        """
-        radius = float(np.max(np.linalg.norm(level_set(threshold), axis=1)))
-        return EuPanel(half_size, 0.4 * half_size / max(radius, 1e-9))
-
-    def to_panel(self, dcm_error: Array) -> Array:
-        """e_u [m] (shape (..., 2)) to panel coordinates [m], clipped to the panel."""
-        points = np.asarray(dcm_error, dtype=float) * self.scale
-        return np.clip(points, -self.half_size, self.half_size)
-
-
-@dataclass(frozen=True)
 class SceneDrawing:
     """Everything drawn for one controller state (world frame, z up) [m].
 
@@ -377,11 +240,6 @@ class SceneDrawing:
         zmp_trail, com_trail, dcm_trail: Recent paths, shape (n, 3).
         push_arrow: Start and end of the push arrow (ends at the CoM), shape (2, 3),
             or None when no push acts.
-        threshold_curve: {V_u = gamma_v} in panel coordinates, shape (m, 2).
-        level_curve: {V_u = current level} in panel coordinates, shape (m, 2).
-        dcm_error_trail: Recent e_u in panel coordinates, shape (n, 2).
-        dcm_error_point: Current e_u in panel coordinates, shape (2,).
-        above_threshold: V_u > gamma_v (the RSG adjusts the next step).
     """
 
     footholds: list[FootholdDrawing]
@@ -393,11 +251,6 @@ class SceneDrawing:
     com_trail: Array
     dcm_trail: Array
     push_arrow: Array | None
-    threshold_curve: Array
-    level_curve: Array
-    dcm_error_trail: Array
-    dcm_error_point: Array
-    above_threshold: bool
 
 
 def rectangle(center: Array, lower: Array, upper: Array) -> Array:
@@ -490,19 +343,11 @@ def footholds(
     return drawings
 
 
-def draw_scene(
-    state: ControllerState,
-    level_set: Callable[[float], Array],
-    panel: EuPanel,
-    foot_lower: Array,
-    foot_upper: Array,
-) -> SceneDrawing:
-    """What is drawn for ``state``.
+def draw_scene(state: ControllerState, foot_lower: Array, foot_upper: Array) -> SceneDrawing:
+    """What is drawn in the 3-D view for ``state``.
 
     Args:
         state: The controller state.
-        level_set: Points of {V_u = level} for a level (``LyapunovDesign.level_set``).
-        panel: The e_u panel's scale.
         foot_lower, foot_upper: Sole corners around the ankle [m], shape (2,).
     """
     return SceneDrawing(
@@ -515,11 +360,6 @@ def draw_scene(
         com_trail=on_ground(state.com_trail, state.com_height),
         dcm_trail=on_ground(state.dcm_trail),
         push_arrow=push_arrow(state.com, state.com_height, state.push_impulse),
-        threshold_curve=panel.to_panel(level_set(state.threshold)),
-        level_curve=panel.to_panel(level_set(state.lyapunov)),
-        dcm_error_trail=panel.to_panel(state.dcm_error_trail),
-        dcm_error_point=panel.to_panel(state.dcm_error),
-        above_threshold=state.lyapunov > state.threshold,
     )
 
 

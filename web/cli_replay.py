@@ -1,0 +1,50 @@
+"""The ``rsg replay`` subcommand, registered in the entry-point group ``rsg.commands``.
+
+``add_parser`` adds its arguments to ``rsg``; ``run`` starts :func:`web.replay.main`.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from .cli_demo import PORT
+
+REPLAY_EPILOG = """\
+examples:
+  rsg run --scenario paper-fig6 --out results/fig6-g1
+  rsg replay results/fig6-g1               # http://127.0.0.1:8080
+  rsg replay results/sweep/replays/rsg-45deg-phase0.5-12.3Ns --port 8081
+
+The page is the demo's (robot, footholds, ZMP window, DCM-error plot, V_u plot, push
+arrows) for the recorded run, with a time slider, Play/Pause and the speed; nothing is
+simulated. rsg sweep and rsg grid keep their worst runs replayable (their reports say
+where). Ctrl-C stops the server.
+"""
+
+
+def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Entry-point hook: add ``replay`` to ``rsg``."""
+    replay = sub.add_parser(
+        "replay",
+        help="replay a recorded run in the browser (the --out folder of rsg run)",
+        description="Serve the browser page of a recorded run: the robot, its footholds and "
+        "the plots at any time of the run, with a time slider, Play/Pause and speed.",
+        epilog=REPLAY_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    replay.add_argument("folder", type=Path, metavar="DIR", help="a run folder (with replay.npz)")
+    replay.add_argument(
+        "--host",
+        default="127.0.0.1",
+        help="address to serve on (default: 127.0.0.1, this machine only)",
+    )
+    replay.add_argument("--port", type=PORT, default=8080, help="port to serve on (default: 8080)")
+    return replay
+
+
+def run(args: argparse.Namespace) -> int:
+    """Entry-point hook: run ``rsg replay``."""
+    from web.replay import main
+
+    return int(main(args))
