@@ -166,9 +166,12 @@ class SimulatedRobot:
         """Whole-body CoM position [m] and velocity [m/s] in the world, shape (3,) each."""
         base_position, _ = self.client.getBasePositionAndOrientation(self.body)
         base_velocity, _ = self.client.getBaseVelocity(self.body)
+        # Forward kinematics of the current state: PyBullet's cached link states are
+        # those of the step before.
         states = self.client.getLinkStates(
-            self.body, list(range(self.link_count)), computeLinkVelocity=1
-        )
+            self.body, list(range(self.link_count)), computeLinkVelocity=1,
+            computeForwardKinematics=1,
+        )  # fmt: skip
         positions = np.array([base_position] + [state[0] for state in states])
         velocities = np.array([base_velocity] + [state[6] for state in states])
         com = self.link_masses @ positions / self.mass

@@ -64,7 +64,7 @@ PUBLISHED_GAINS = {
     "ankle": (40.0, 2.0),
     "waist_yaw": (60.0, 1.0),
     "waist": (40.0, 1.0),
-    "shoulder": (40.0, 1.0),
+    "arm": (40.0, 1.0),
 }
 # Those gains serve a learned policy that closes its own loop at 50 Hz; tracking the IK
 # with a feed-forward here, the joints but the ankles take 5 x kp and 10 x kd (the
@@ -73,16 +73,15 @@ STIFFNESS_FACTOR, DAMPING_FACTOR = 5.0, 10.0
 
 
 def _impedance(joint: str) -> JointImpedance:
-    group = next(
-        g for g in ("waist_yaw", "hip", "knee", "ankle", "waist", "shoulder") if g in joint
-    )
+    group = next((g for g in ("waist_yaw", "hip", "knee", "ankle", "waist") if g in joint), "arm")
     kp, kd = PUBLISHED_GAINS[group]
     if group == "ankle":
         return JointImpedance(kp, kd)
     return JointImpedance(STIFFNESS_FACTOR * kp, DAMPING_FACTOR * kd)
 
 
-_ACTUATED = [
+# Every joint has gains, the welded ones too (they move with ``--set locked_joints=none``).
+_JOINTS = [
     f"{side}_{joint}_joint"
     for side in ("left", "right")
     for joint in ("hip_pitch", "hip_roll", "hip_yaw", "knee", "ankle_pitch", "ankle_roll")
@@ -90,7 +89,12 @@ _ACTUATED = [
     "waist_yaw_joint",
     "waist_roll_joint",
     "waist_pitch_joint",
-    *(f"{side}_shoulder_{axis}_joint" for side in ("left", "right") for axis in ("pitch", "roll")),
+    *(
+        f"{side}_{joint}_joint"
+        for side in ("left", "right")
+        for joint in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")
+        + ("wrist_roll", "wrist_pitch", "wrist_yaw")
+    ),
 ]
 
 G1 = RobotDescription(
@@ -105,7 +109,7 @@ G1 = RobotDescription(
     com_height=0.66,
     foot_spacing=0.23,
     standing_posture=STANDING_POSTURE,
-    joint_impedance={joint: _impedance(joint) for joint in _ACTUATED},
+    joint_impedance={joint: _impedance(joint) for joint in _JOINTS},
     total_mass=33.3,
     physics_time_step=0.002,
     solver_iterations=75,

@@ -13,7 +13,6 @@ from app.backend import InitialCondition
 from app.lowlevel import JointCommand
 from app.pybullet_backend import PyBulletBackend
 from app.pybullet_robot import SimulatedRobot
-from app.stabilizer.config import StabilizerConfig
 from app.stabilizer.controller import joint_impedance
 from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from robots import get_robot
@@ -76,12 +75,12 @@ def joint_errors(sim, indices, target):
 def test_the_stable_pd_settles_where_the_explicit_law_at_the_same_gains_chatters(hung):
     """G1's ankle roll joint moves a light foot: kd dt / I is far above 2, where an
     explicit damping term overshoots every step. Started 0.1 rad off, with the
-    stabilizer's gains and gravity as feed-forward: the stable PD (Tan, Liu and Turk
+    G1's gains and gravity as feed-forward: the stable PD (Tan, Liu and Turk
     2011) settles (measured 0.04 deg after 0.25 s); the explicit law, evaluated at each
     2 ms physics step in this test, chatters between 3 and 15 deg (measured)."""
     sim = hung
     model = sim.motors.model
-    stiffness, damping = joint_impedance(model, StabilizerConfig())
+    stiffness, damping = joint_impedance(model, G1)
     roll = model.joint_names.index("left_ankle_roll_joint")
     target = posture(model)
     offsets = np.where(["ankle_roll" in name for name in model.joint_names], 0.1, 0.0)
@@ -126,7 +125,7 @@ def test_torques_never_exceed_the_effort_limits(hung):
     and stay within them."""
     sim = hung
     model = sim.motors.model
-    stiffness, damping = joint_impedance(model, StabilizerConfig())
+    stiffness, damping = joint_impedance(model, G1)
     target = posture(model) + 1.0
     feedforward, hanging, _ = hang(sim, np.zeros(len(target)), target)
     torques = []

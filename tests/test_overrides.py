@@ -85,7 +85,7 @@ def test_each_name_goes_where_it_applies() -> None:
     ("overrides", "model", "field"),
     [
         ((("no_such_parameter", "1"),), "pybullet", "--set"),
-        ((("landing_admittance", "0.002"),), "lipm", "--set landing_admittance"),  # PyBullet
+        ((("landing_depth", "0.004"),), "lipm", "--set landing_depth"),  # PyBullet
         ((("step_width", "0.3"),), "lipm", "--set"),  # the paper's LIPM: RSG parameters
         ((("crossing_margin", "0.03"), ("crossing_margin", "0.04")), "lipm",
          "--set crossing_margin"),
@@ -103,10 +103,10 @@ def test_bad_overrides_name_the_parameter(overrides: tuple, model: str, field: s
 def test_a_robot_description_takes_fields_and_backend_options() -> None:
     tuned = dataclasses.replace(get_robot("g1"), backend_options={"landing_depth": 0.004})
     description, _ = robot_with_overrides(
-        tuned, (("swing_preparation_time", "0.3"), ("landing_admittance", "0.002"))
+        tuned, (("swing_preparation_time", "0.3"), ("landing_depth", "0.004"))
     )
     assert description.swing_preparation_time == 0.3
-    assert description.backend_options["landing_admittance"] == 0.002
+    assert description.backend_options["landing_depth"] == 0.004
     # The description's own options are kept.
     assert description.backend_options["landing_depth"] == 0.004
     with pytest.raises(ParameterError) as error:
@@ -120,7 +120,7 @@ def test_the_robot_backend_and_planner_receive_the_overrides() -> None:
         "rsg",
         (
             ("swing_preparation_time", "0.3"),
-            ("landing_admittance", "0.002"),
+            ("landing_depth", "0.004"),
             ("estimator", "odometry"),
             ("control_period", "0.004"),
             ("crossing_margin", "0.03"),
@@ -128,8 +128,8 @@ def test_the_robot_backend_and_planner_receive_the_overrides() -> None:
     )
     try:
         stabilizer = backend.controller.config
-        assert stabilizer.landing_admittance == 0.002 and stabilizer.estimator == "odometry"
-        assert backend.controller.landing.admittance == 0.002
+        assert stabilizer.landing_depth == 0.004 and stabilizer.estimator == "odometry"
+        assert backend.controller.landing.depth == 0.004
         assert backend.controller.estimator.source == "odometry"
         assert backend.control_period == 0.004 == backend.controller.period
         assert config.rsg.swing_preparation_time == 0.3
@@ -177,11 +177,11 @@ def test_the_run_command_records_the_overrides(tmp_path: Path, capsys) -> None:
 
 def test_a_bad_override_is_a_clear_error_before_any_run(tmp_path: Path, capsys) -> None:
     code = main(
-        ["grid", "--model", "lipm", "--set", "landing_admittance=0.002", "--out", str(tmp_path)]
+        ["grid", "--model", "lipm", "--set", "landing_depth=0.004", "--out", str(tmp_path)]
     )
     assert code == 2
     err = capsys.readouterr().err
-    assert "--set landing_admittance" in err and "only with --model pybullet" in err
+    assert "--set landing_depth" in err and "only with --model pybullet" in err
     assert not (tmp_path / "grid.json").exists()
     with pytest.raises(ParameterError):
         GridSpec(overrides=(("swing_preparation_time", "soon"),))
@@ -241,13 +241,13 @@ def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
     _, paper, _ = build_backend("lipm", None, "rsg")
     assert paper.model.mass != pytest.approx(g1.total_mass)
     with pytest.raises(ParameterError) as error:
-        build_backend("lipm", "g1", "rsg", overrides=(("landing_admittance", "0.002"),))
-    assert error.value.field == "--set landing_admittance"
+        build_backend("lipm", "g1", "rsg", overrides=(("landing_depth", "0.004"),))
+    assert error.value.field == "--set landing_depth"
     assert "only with --model pybullet" in error.value.allowed
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("no_such_name", "0.2"),))
     assert "swing_preparation_time" in error.value.allowed
-    assert "landing_admittance" not in error.value.allowed
+    assert "landing_depth" not in error.value.allowed
     assert "swing_preparation_time" in allowed_names("lipm", "g1")
     assert (
         "swing_preparation_time"

@@ -1,11 +1,10 @@
-"""The stabilizer's options (:class:`app.stabilizer.config.StabilizerConfig`) and the
-joint impedance they give."""
+"""The stabilizer's options (:class:`app.stabilizer.config.StabilizerConfig`) and each
+robot's joint gains."""
 
 from __future__ import annotations
 
 import dataclasses
 
-import numpy as np
 import pytest
 
 from app.pybullet_backend import stabilizer_config
@@ -14,6 +13,7 @@ from app.stabilizer.controller import joint_impedance
 from kinematics.robot_model import RobotModel
 from planner.exceptions import ParameterError
 from robots import get_robot
+from robots.g1 import DAMPING_FACTOR, PUBLISHED_GAINS, STIFFNESS_FACTOR
 
 
 @pytest.fixture(autouse=True)
@@ -49,7 +49,7 @@ def test_each_number_option_refuses_values_out_of_its_range_or_of_the_wrong_type
         assert f"[{low:g}, {high:g}]" in error.value.allowed
     for value in (low, high, (low + high) / 2):
         assert getattr(StabilizerConfig(**{name: value}), name) == value
-    assert StabilizerConfig(stiffness_angle=1).stiffness_angle == 1  # an int is a number
+    assert StabilizerConfig(friction=1).friction == 1  # an int is a number
 
 
 @pytest.mark.parametrize("value", ["kalman", "", 1, None])
@@ -72,23 +72,44 @@ def test_a_robots_backend_options_are_its_stabilizer_options():
     assert all(name in error.value.allowed for name in OPTION_NAMES)
 
 
-def test_joint_impedance_reaches_the_effort_limit_at_the_stiffness_angle():
-    """kp = effort / angle (the ankles with their own angle), kd = kp * damping time;
-    on G1 the ankles are the pitch and roll joints above each sole."""
-    model = RobotModel(get_robot("g1"))
-    config = StabilizerConfig(
-        stiffness_angle=0.2, ankle_stiffness_angle=0.8, damping_time=0.03, ankle_damping_time=0.07
-    )
-    stiffness, damping = joint_impedance(model, config)
+def test_g1s_joint_gains_are_unitrees_published_ones_scaled_but_the_ankles():
+    """Every joint of the model has gains; the ankles (pitch and roll above each sole)
+    keep Unitree's kp 40, kd 2; the others take 5 x kp and 10 x kd."""
+    description = get_robot("g1")
+    model = RobotModel(description)
+    stiffness, damping = joint_impedance(model, description)
     ankles = {name for name in model.joint_names if model.is_ankle(name)}
     assert ankles == {
         f"{side}_ankle_{axis}_joint" for side in ("left", "right") for axis in ("pitch", "roll")
     }
-    effort = model.effort_limits
-    assert np.all(effort > 0.0)
     for index, name in enumerate(model.joint_names):
-        angle, time = (0.8, 0.07) if name in ankles else (0.2, 0.03)
+        group = next(
+            (g for g in ("waist_yaw", "hip", "knee", "ankle", "waist") if g in name), "arm"
+        )
+        kp, kd = PUBLISHED_GAINS[group]
+        scale = (1.0, 1.0) if name in ankles else (STIFFNESS_FACTOR, DAMPING_FACTOR)
+        assert stiffness[index] == pytest.approx(scale[0] * kp), name
+        assert damping[index] == pytest.approx(scale[1] * kd), name
+    assert stiffness[model.joint_names.index("left_knee_joint")] == pytest.approx(1500.0)
+
+
+def test_talos_joints_reach_their_effort_limit_at_a_tenth_of_a_radian():
+    """No gains are published for Talos: kp = effort / 0.1 rad (ankles / 1 rad)."""
+    description = get_robot("talos")
+    model = RobotModel(description)
+    stiffness, _ = joint_impedance(model, description)
+    effort = model.effort_limits
+    for index, name in enumerate(model.joint_names):
+        angle = 1.0 if model.is_ankle(name) else 0.1
         assert stiffness[index] * angle == pytest.approx(effort[index]), name
-        assert damping[index] == pytest.approx(stiffness[index] * time), name
-    knee = model.joint_names.index("left_knee_joint")
-    assert stiffness[knee] == pytest.approx(139.0 / 0.2)  # G1's knee: 139 N m
+
+
+def test_a_joint_without_gains_is_refused_naming_it():
+    description = get_robot("g1")
+    model = RobotModel(description)
+    gains = dict(description.joint_impedance)
+    del gains["left_knee_joint"]
+    with pytest.raises(ParameterError) as error:
+        joint_impedance(model, dataclasses.replace(description, joint_impedance=gains))
+    assert error.value.field == "joint_impedance"
+    assert error.value.value == ["left_knee_joint"]

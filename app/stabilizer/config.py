@@ -20,9 +20,6 @@ class StabilizerConfig:
             sole, encoders and IMU, what a real G1 has).
         landing_depth: How far below the ground the swing sole aims at the planned
             landing time [m], so it touches down by then rather than after.
-        landing_admittance: Landing compliance [m/(N s)]: a touching swing sole
-            rises at this speed per newton it carries above ``touch_force``.
-        touch_force: Load a touching swing sole is allowed [-, fraction of m g].
         friction: Coulomb coefficient of the wrench distribution's contacts [-].
         flywheel_momentum: h_max, angular momentum the upper body may carry [N m s]
             (0: no flywheel; the whole hdot goes to the CoP).
@@ -34,8 +31,6 @@ class StabilizerConfig:
 
     estimator: str = "truth"
     landing_depth: float = 0.005
-    landing_admittance: float = 0.003
-    touch_force: float = 0.05
     friction: float = 0.7
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
@@ -55,8 +50,6 @@ class StabilizerConfig:
 #: Physically meaningful range of each number option (units as in the attributes).
 RANGES: dict[str, tuple[float, float]] = {
     "landing_depth": (0.0, 0.02),
-    "landing_admittance": (0.0, 0.05),
-    "touch_force": (0.0, 1.0),
     "friction": (0.1, 2.0),
     "flywheel_momentum": (0.0, 10.0),
     "flywheel_return_time": (0.05, 10.0),

@@ -95,12 +95,7 @@ class WholeBodyController:
             descent_slope=SWING_DESCENT_SLOPE,
             land_on_time=True,
         )
-        self.landing = Landing(
-            config.landing_depth,
-            config.landing_admittance,
-            config.touch_force * self.mass * GRAVITY,
-            timing.double_support,
-        )
+        self.landing = Landing(config.landing_depth, timing.double_support)
         self.limits = ContactLimits(description.sole, friction=config.friction)
         self.stiffness, self.damping = joint_impedance(self.model, description)
         self._ankle_height = -float(description.sole_offset[2])
@@ -129,7 +124,6 @@ class WholeBodyController:
         self.planned_cop = np.array(com_xy, dtype=float)
         self.ik_failure: str | None = None
         self._contacts: list[FootContact] = []
-        self.landing.reset()
 
     def reset(
         self,
@@ -196,7 +190,6 @@ class WholeBodyController:
 
     def _start_swing(self, stance: Foot, swing: Foot) -> None:
         self.swing.start(self.model.sole_frame(swing)[0][:2])
-        self.landing.reset()
         _, rotation = self.model.sole_frame(stance)
         self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
         self._stance = stance
@@ -216,9 +209,7 @@ class WholeBodyController:
         if command.double_support:
             stance_height = self.landing.stance_height(time_since_step)
         else:
-            position[2] = self.landing.swing_height(
-                position[2], landing_time - time_since_step, measurement.normal_force(swing), dt
-            )
+            position[2] = self.landing.swing_height(position[2], landing_time - time_since_step)
         foothold = np.array([*command.stance.position, stance_height])
         return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position)}
 

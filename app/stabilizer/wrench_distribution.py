@@ -29,7 +29,8 @@ from robots.description import SoleRectangle
 FORCE_WEIGHT = 1.0  # on the net force error [-]
 MOMENT_WEIGHT = 1e-2  # on the horizontal moment about the desired CoP [1/m^2]
 ANKLE_WEIGHT = 1e-4  # on each foot's ankle torque [1/m^2] (breaks ties)
-REGULARISATION = 1e-8  # on every wrench coordinate
+# (regularisation on every wrench coordinate, proxqp's eps_abs): the second if the first stalls
+ATTEMPTS = ((1e-8, 1e-8), (1e-6, 1e-7))
 
 
 @dataclass(frozen=True)
@@ -162,7 +163,6 @@ def distribute_wrench(
         ankle = np.hstack([-_skew(np.array([0.0, 0.0, contact.ankle_height])), np.eye(3)])[:2]
         block = slice(6 * index, 6 * index + 6)
         P[block, block] += ANKLE_WEIGHT * ankle.T @ ankle
-    P += REGULARISATION * np.eye(size)
     cones = [_cone(limits, contact) for contact in contacts]
     G = np.zeros((sum(len(h) for _, h in cones), size))
     h = np.concatenate([h for _, h in cones]) / scale
@@ -170,7 +170,18 @@ def distribute_wrench(
     for index, (G_foot, h_foot) in enumerate(cones):
         G[row : row + len(h_foot), 6 * index : 6 * index + 6] = G_foot
         row += len(h_foot)
-    solution = solve_qp(P, q, G, h, solver="proxqp", eps_abs=1e-8, eps_rel=0.0)
+    for regularisation, eps_abs in ATTEMPTS:
+        solution = solve_qp(
+            P + regularisation * np.eye(size),
+            q,
+            G,
+            h,
+            solver="proxqp",
+            eps_abs=eps_abs,
+            eps_rel=0.0,
+        )
+        if solution is not None:
+            break
     if solution is None:
         raise WrenchDistributionError(count, np.asarray(force, float), np.asarray(cop, float))
     return [scale * solution[6 * i : 6 * i + 6] for i in range(count)]
