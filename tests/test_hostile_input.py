@@ -380,7 +380,7 @@ def description_field_cases() -> list[Case]:
     for name in ("physics_time_step=0.001", "solver_iterations=10", "locked_joints=none",
                  "fall_tilt=0.5", "ground_friction=0.8", "swing_height=0.05",
                  "foot_spacing=0.2", "fall_base_height=0.3", "sole_spinning_friction=0",
-                 "landing_admittance=0.002", "control_period=0.005"):  # fmt: skip
+                 "landing_depth=0.004", "control_period=0.005"):  # fmt: skip
         cases.append(set_case(f"pybullet-only-{name}", name, f"--set {name.split('=')[0]}",
                               "only with --model pybullet", robot="g1"))  # fmt: skip
     for pair in ("step_min", "step_max"):
@@ -445,8 +445,8 @@ OVERRIDES = [
     ),
     set_case(
         "backend-option-on-paper-lipm",
-        "landing_admittance=0.002",
-        "--set landing_admittance",
+        "landing_depth=0.004",
+        "--set landing_depth",
         "only with --model pybullet",
     ),
     set_case(
@@ -903,15 +903,15 @@ BENCH = [
     bench_case("robot-unknown", ["--robot", "atlas"], "robot='atlas'"),
     bench_case(
         "set-with-no-robot",
-        ["--no-robot", "--set", "landing_admittance=0.002"],
-        "--set='landing_admittance=0.002'",
+        ["--no-robot", "--set", "landing_depth=0.004"],
+        "--set='landing_depth=0.004'",
         "--no-robot",
     ),
     bench_case(
         "set-out-of-range",
-        ["--set", "landing_admittance=5"],
-        "--set landing_admittance",
-        "[0, 0.05]",
+        ["--set", "landing_depth=5"],
+        "--set landing_depth",
+        "[0, 0.02]",
     ),
     bench_case("set-unknown", ["--set", "bogus=1"], "--set='bogus'"),
 ]

@@ -67,11 +67,12 @@ def run_g1(
         backend.close()
 
 
-def test_two_identical_runs_give_identical_results():
+def test_two_identical_runs_give_the_same_results():
+    """To 0.1 mm (not bit-exact under torque control: docs/full-robot.md)."""
     first, first_errors = run_g1(BUILT_IN["walk"], duration=1.5)
     second, second_errors = run_g1(BUILT_IN["walk"], duration=1.5)
-    assert np.array_equal(first.timeseries, second.timeseries)
-    assert first_errors == second_errors
+    np.testing.assert_allclose(first.timeseries, second.timeseries, rtol=0.0, atol=1e-4)
+    np.testing.assert_allclose(first_errors, second_errors, rtol=0.0, atol=1e-4)
     assert [s.event for s in first.steps] == [s.event for s in second.steps]
 
 

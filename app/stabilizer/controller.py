@@ -170,7 +170,7 @@ class WholeBodyController:
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
         # swing foot
-        soles = self._sole_targets(command, measurement, stance, swing)
+        soles = self._sole_targets(command, stance, swing)
         # IK
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
@@ -195,7 +195,7 @@ class WholeBodyController:
         self._stance = stance
 
     def _sole_targets(
-        self, command: PlannerOutput, measurement: RobotMeasurement, stance: Foot, swing: Foot
+        self, command: PlannerOutput, stance: Foot, swing: Foot
     ) -> dict[Foot, NDArray[np.float64]]:
         """4x4 targets of both soles: the stance sole on the planner's foothold, the
         swing sole on its trajectory to the announced step, with the landing rules."""
