@@ -176,9 +176,7 @@ def test_the_run_command_records_the_overrides(tmp_path: Path, capsys) -> None:
 
 
 def test_a_bad_override_is_a_clear_error_before_any_run(tmp_path: Path, capsys) -> None:
-    code = main(
-        ["grid", "--model", "lipm", "--set", "landing_depth=0.004", "--out", str(tmp_path)]
-    )
+    code = main(["grid", "--model", "lipm", "--set", "landing_depth=0.004", "--out", str(tmp_path)])
     assert code == 2
     err = capsys.readouterr().err
     assert "--set landing_depth" in err and "only with --model pybullet" in err
