@@ -26,7 +26,8 @@ for k in range(round(scenario.duration / dt)):
     levels.append(out.lyapunov)
     if out.step is not None:
         kind = "adjusted" if out.step.adjusted else "nominal"
-        print(f"t = {t:5.2f} s  {kind:8s} step of the {out.step.foot} foot to {np.round(out.step.position, 3)} m")
+        where = np.round(out.step.position, 3)
+        print(f"t = {t:5.2f} s  {kind:8s} step of the {out.step.foot} foot to {where} m")
     force = scenario.impulse_between(t, t + dt) / dt  # [N], the tick's mean push force
     state = backend.step(out, force)
 gamma = config.rsg.lyapunov_threshold
