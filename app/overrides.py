@@ -8,9 +8,9 @@ A name is looked up in this order:
 1. a field of the robot description (:class:`robots.description.RobotDescription`):
    gait, planner bounds and timing (``swing_preparation_time``, ``step_reaction_time``,
    ``filter_time_constant``, ``angular_momentum_rate_max``, ``com_height``, ...);
-2. an option of the PyBullet backend (the keyword arguments of
-   :class:`app.pybullet_backend.PyBulletBackend`: ``cop_admittance``,
-   ``cop_feedback``, ``swing_descent_slope``, ``landing_clearance``, ...);
+2. an option of the PyBullet backend: the whole-body stabilizer's
+   (:class:`app.stabilizer.config.StabilizerConfig`: ``landing_depth``,
+   ``flywheel_momentum``, ``estimator``, ...) and ``control_period``;
 3. a parameter of the RSG (:class:`planner.parameters.RsgParameters`) that the
    description does not set (``crossing_margin``, ``step_decrease_margin``,
    ``push_hold_time``, ...).
@@ -22,8 +22,8 @@ mass) the description fields its planner reads and the RSG parameters of 3.
 RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
-(``cop_feedback=0,2``), ``none`` where the option allows it, or a word for a
-string option (``plan_angular_momentum=feedback``), or comma-separated joint names
+(``step_max=0.35,0.4``), ``none`` where the option allows it, or a word for a
+string option (``estimator=odometry``), or comma-separated joint names
 (``locked_joints=none`` actuates every joint). Numbers are ASCII decimals (no nan,
 inf, hex or ``_``). Each parameter has a range, defined where the parameter is (the
 planner's ``planner.parameters.RANGES``, the description, the backend's
@@ -37,7 +37,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import inspect
 import re
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -100,20 +99,14 @@ MAX_VALUE_LENGTH = 1000
 _NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?", re.ASCII)
 _INTEGER = re.compile(r"[+-]?\d{1,9}", re.ASCII)
 
-#: Backend keyword arguments that are not options of a run.
-_NOT_BACKEND_OPTIONS = {"self", "robot", "timing"}
-
 
 def backend_option_types() -> dict[str, str]:
-    """PyBullet backend option -> its annotation (``"float"``, ``"bool"``, ...)."""
-    from .pybullet_backend import PyBulletBackend
+    """PyBullet backend option -> its annotation (``"float"``, ``"str"``, ...): the
+    whole-body stabilizer's options and the control period."""
+    from app.stabilizer.config import StabilizerConfig
 
-    parameters = inspect.signature(PyBulletBackend.__init__).parameters
-    return {
-        name: str(parameter.annotation)
-        for name, parameter in parameters.items()
-        if name not in _NOT_BACKEND_OPTIONS
-    }
+    types = {field.name: str(field.type) for field in dataclasses.fields(StabilizerConfig)}
+    return {**types, "control_period": "float"}
 
 
 def _paper_point_mass(model: str, robot: str | None) -> bool:
@@ -173,7 +166,7 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="change one parameter: a robot description field, a PyBullet backend option "
-        "or an RSG parameter, e.g. --set swing_preparation_time=0.3 --set cop_admittance=0.2 "
+        "or an RSG parameter, e.g. --set swing_preparation_time=0.3 --set landing_depth=0.003 "
         "(repeatable; a wrong name lists the allowed ones, a value out of range gives the "
         "range)",
     )
@@ -336,8 +329,6 @@ def apply_to_description(
     if not parsed.description and not parsed.backend:
         return description
     fields = dict(parsed.description)
-    if "physics_time_step" in fields:  # with the gains that keep the servos' time constants
-        description = description.with_physics_time_step(fields.pop("physics_time_step"))
     options = {**description.backend_options, **parsed.backend}
     return dataclasses.replace(description, **fields, backend_options=options)
 

@@ -1,24 +1,32 @@
-"""A biped in its own PyBullet world: loading, state measurement, actuation.
+"""A biped in its own PyBullet world: loading, its sensors and its joint motors.
 
 One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
 coexist in a process), a flat ground with friction, and the robot loaded from the
 derived URDF with the URDF's inertias, its fixed-joint links merged into their
 parents (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per
 physics step; a ground contact of the head is reported as one of ``torso_link``).
+PyBullet's own joint motors are off (``VELOCITY_CONTROL`` with zero force): the
+joints are torque-driven by :class:`app.joint_motors.JointMotors`, the G1's low-level
+PD law with feed-forward, at every physics step (:meth:`actuate`); :meth:`measure`
+gives the low-level measurement record (:mod:`app.lowlevel`).
 Frames: PyBullet's base pose is the base link's *inertial* frame;
 :meth:`base_pose` converts it to the URDF base frame.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
 from kinematics.native_output import native_output_silenced
+from kinematics.robot_model import RobotModel
 from robots.description import RobotDescription
 from robots.urdf_cache import derived_urdf
+
+from .joint_motors import JointMotors
+from .lowlevel import FootForce, JointCommand, RobotMeasurement
 
 with native_output_silenced():  # pybullet prints its build time when first imported
     import pybullet
@@ -88,11 +96,6 @@ class SimulatedRobot:
         self.mass = float(self.link_masses.sum())
         base_info = client.getDynamicsInfo(self.body, -1)
         self._base_inertial = (base_info[3], base_info[4])
-        gains = [description.gains_of(name) for name in self.joint_names]
-        self._position_gains = [g.position_gain for g in gains]
-        self._velocity_gains = [g.velocity_gain for g in gains]
-        self._max_forces = [g.max_force for g in gains]
-        self._zero_velocities = [0.0] * len(self.joint_names)
         # The module functions with the client id: BulletClient's per-call
         # attribute lookup (a functools.partial each time) costs ~1 us per call.
         self._client_id = client._client
@@ -100,6 +103,13 @@ class SimulatedRobot:
         self._step_simulation = pybullet.stepSimulation
         self._contacts: tuple | None = None  # contact points of the current state
         self.time = 0.0
+        model = RobotModel(description)
+        # The low-level interface orders joints as the rigid-body model does.
+        self._model_indices = [
+            self.joint_indices[self.joint_names.index(name)] for name in model.joint_names
+        ]
+        self.motors = JointMotors(model, self.time_step)
+        self._motor_target = np.zeros(len(self.joint_names))
 
     # ----------------------------------------------------------------- state
     def set_configuration(
@@ -156,9 +166,12 @@ class SimulatedRobot:
         """Whole-body CoM position [m] and velocity [m/s] in the world, shape (3,) each."""
         base_position, _ = self.client.getBasePositionAndOrientation(self.body)
         base_velocity, _ = self.client.getBaseVelocity(self.body)
+        # Forward kinematics of the current state: PyBullet's cached link states are
+        # those of the step before.
         states = self.client.getLinkStates(
-            self.body, list(range(self.link_count)), computeLinkVelocity=1
-        )
+            self.body, list(range(self.link_count)), computeLinkVelocity=1,
+            computeForwardKinematics=1,
+        )  # fmt: skip
         positions = np.array([base_position] + [state[0] for state in states])
         velocities = np.array([base_velocity] + [state[6] for state in states])
         com = self.link_masses @ positions / self.mass
@@ -238,26 +251,90 @@ class SimulatedRobot:
         _, rotation = self._foot_frame(foot, True)
         return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
 
-    # ------------------------------------------------------------- actuation
-    def set_joint_targets(
-        self, angles: NDArray[np.float64], velocities: NDArray[np.float64] | None = None
-    ) -> None:
-        """Position targets [rad] (and velocity targets [rad/s]) in joint_names order.
-
-        Called at every physics step: the arguments go to PyBullet as plain lists
-        and the gains are prepared once (measured 8.4 -> 4.2 us per call).
-        """
-        self._set_motors(
-            self.body,
-            self.joint_indices,
-            pybullet.POSITION_CONTROL,
-            targetPositions=angles.tolist(),
-            targetVelocities=self._zero_velocities if velocities is None else velocities.tolist(),
-            positionGains=self._position_gains,
-            velocityGains=self._velocity_gains,
-            forces=self._max_forces,
-            physicsClientId=self._client_id,
+    # ------------------------------------------------------- torque control
+    def measure(self) -> RobotMeasurement:
+        """Encoders, IMU, foot forces and the base's true pose and velocity (joints in
+        the rigid-body model's order, :class:`kinematics.robot_model.RobotModel`)."""
+        states = self.client.getJointStates(self.body, self._model_indices)
+        position, quaternion = self.base_pose()
+        inertial_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        linear, angular = self.client.getBaseVelocity(self.body)
+        rotation = np.array(self.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+        # PyBullet's base velocity is that of the inertial frame origin.
+        origin_velocity = np.array(linear) + np.cross(
+            angular, position - np.array(inertial_position)
         )
+        forces = {
+            foot: FootForce(force, cop) for foot, (cop, force) in self.foot_pressure().items()
+        }
+        return RobotMeasurement(
+            time=self.time,
+            joint_positions=np.array([s[0] for s in states]),
+            joint_velocities=np.array([s[1] for s in states]),
+            base_orientation=np.asarray(quaternion, float),
+            base_angular_velocity=rotation.T @ np.asarray(angular, float),
+            foot_forces=forces,
+            base_position=np.asarray(position, float),
+            base_linear_velocity=origin_velocity,
+        )
+
+    def set_motor_target(self, angles: NDArray[np.float64]) -> None:
+        """Where the next tick's target angles start from [rad] (after a reset)."""
+        self._motor_target = np.asarray(angles, float).copy()
+
+    def actuate(
+        self,
+        command: JointCommand,
+        measurement: RobotMeasurement,
+        steps: int,
+        expected_contact_force: NDArray[np.float64],
+        base_force_world: NDArray[np.float64] | None = None,
+        observer: Callable[[SimulatedRobot, NDArray[np.float64] | None], None] | None = None,
+    ) -> None:
+        """Run ``steps`` physics steps with the motors on ``command`` (torque control).
+
+        ``measurement`` is the state at the start of the tick (the motors' model
+        uses its true base state); ``expected_contact_force`` is J^T f of the contact
+        forces expected over the tick (:mod:`app.joint_motors`). ``base_force_world``
+        [N] pushes the pelvis; ``observer`` is called after each physics step.
+        """
+        motors = self.motors
+        model = motors.model
+        q = np.concatenate(
+            [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
+        )
+        rotation = np.array(
+            self.client.getMatrixFromQuaternion(measurement.base_orientation)
+        ).reshape(3, 3)
+        v = np.concatenate(
+            [
+                rotation.T @ measurement.base_linear_velocity,
+                measurement.base_angular_velocity,
+                measurement.joint_velocities,
+            ]
+        )
+        model.update(q, v)
+        motors.prepare(command, self._motor_target, expected_contact_force)
+        self._motor_target = command.position.copy()
+        for step in range(1, steps + 1):
+            states = pybullet.getJointStates(
+                self.body, self._model_indices, physicsClientId=self._client_id
+            )
+            torques = motors.torques(
+                step / steps,
+                np.array([s[0] for s in states]),
+                np.array([s[1] for s in states]),
+            )
+            self._set_motors(
+                self.body,
+                self._model_indices,
+                pybullet.TORQUE_CONTROL,
+                forces=torques.tolist(),
+                physicsClientId=self._client_id,
+            )
+            self.step(base_force_world)
+            if observer is not None:
+                observer(self, base_force_world)
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step (``time_step`` [s]) with a force [N] on the base CoM.

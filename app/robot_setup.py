@@ -108,8 +108,7 @@ def build_robot_backend(  # noqa: ANN201
 
     check_overrides(overrides, "pybullet", robot, controller, paper)
     description, parsed = robot_with_overrides(robot, overrides)
-    backend = PyBulletBackend(description, **description.backend_options)
-    config = planner_config_for(description, backend.mass, controller)
+    config = planner_config_for(description, description.total_mass, controller)
     if paper:
         config = paper_rules(config)
     config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
@@ -118,8 +117,8 @@ def build_robot_backend(  # noqa: ANN201
         config.rsg.swing_preparation_time,
         config.gait.step_duration,
     )
-    backend.timing = timing
-    backend.swing.timing = timing
+    backend = PyBulletBackend(description, timing)
+    config = replace(config, model=replace(config.model, mass=backend.mass))
     initial: InitialCondition = walking_start(config)
     return backend, config, initial
 

@@ -7,13 +7,13 @@ Adding a robot: write one module with a :class:`RobotDescription` and add it to
 from __future__ import annotations
 
 from planner.exceptions import ParameterError
-from robots.description import JointGains, RobotDescription, SoleRectangle
+from robots.description import JointImpedance, RobotDescription, SoleRectangle
 from robots.g1 import G1
 from robots.talos import TALOS
 
 _REGISTRY: dict[str, RobotDescription] = {robot.name: robot for robot in (G1, TALOS)}
 
-__all__ = ["JointGains", "RobotDescription", "SoleRectangle", "available_robots", "get_robot"]
+__all__ = ["JointImpedance", "RobotDescription", "SoleRectangle", "available_robots", "get_robot"]
 
 
 def available_robots() -> list[str]:

@@ -8,7 +8,6 @@ frame of a foot has its origin on the ground below the ankle, x forward, z up.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -35,29 +34,22 @@ PLANNER_FIELDS = (
 
 
 @dataclass(frozen=True)
-class JointGains:
-    """PyBullet POSITION_CONTROL parameters of one joint.
+class JointImpedance:
+    """A joint motor's PD gains (the G1 low level's kp and kd).
 
     Attributes:
-        position_gain: PyBullet ``positionGain`` kp [-], in (0, 1]: the joint motor's
-            velocity target is kp (target - angle) / dt at each physics step of dt,
-            so the servo's time constant is about dt / kp
-            (``RobotDescription.physics_time_step``).
-        velocity_gain: PyBullet ``velocityGain`` kd [-], in [0, 1.5].
-        max_force: Maximum joint torque the motor may apply [N m], > 0.
+        stiffness: kp [N m/rad], > 0.
+        damping: kd [N m s/rad], >= 0.
     """
 
-    position_gain: float
-    velocity_gain: float
-    max_force: float
+    stiffness: float
+    damping: float
 
     def __post_init__(self) -> None:
-        if not 0.0 < self.position_gain <= 1.0:
-            raise ParameterError("position_gain", self.position_gain, "0 < kp <= 1")
-        if not 0.0 <= self.velocity_gain <= 1.5:
-            raise ParameterError("velocity_gain", self.velocity_gain, "0 <= kd <= 1.5")
-        if not self.max_force > 0.0:
-            raise ParameterError("max_force", self.max_force, "> 0 N m")
+        if not (math.isfinite(self.stiffness) and 0.0 < self.stiffness <= 1e5):
+            raise ParameterError("stiffness", self.stiffness, "a number in (0, 1e5] N m/rad")
+        if not (math.isfinite(self.damping) and 0.0 <= self.damping <= 1e3):
+            raise ParameterError("damping", self.damping, "a number in [0, 1e3] N m s/rad")
 
 
 def _check_physics_time_step(value: float) -> None:
@@ -106,9 +98,8 @@ class RobotDescription:
         foot_spacing: Nominal lateral distance between the two ankles [m].
         standing_posture: Joint name -> angle [rad] of the nominal posture; joints
             not listed are at 0 rad.
-        joint_gains: Joint name -> PyBullet gains; missing joints use
-            ``default_gains``.
-        default_gains: Gains of joints not in ``joint_gains``.
+        joint_impedance: Joint name -> its motor's PD gains, for every actuated
+            joint that is not locked.
         total_mass: Mass from the URDF [kg] (checked against PyBullet in the tests).
         fall_base_height: Pelvis height [m] under which the robot counts as fallen.
         fall_tilt: Pelvis tilt from vertical [rad] over which it counts as fallen.
@@ -140,22 +131,21 @@ class RobotDescription:
             step puts the new sole's centre line at least this far outside the
             predicted DCM; None: (27c) as printed.
         physics_time_step: PyBullet's fixed time step [s], in [0.0005, 0.005];
-            the control period must be a multiple of it. The joint gains are per
-            step (:class:`JointGains`); :meth:`with_physics_time_step` changes the
-            step and keeps the servos' time constants.
+            the control period must be a multiple of it.
         solver_iterations: Iterations of PyBullet's contact and joint-motor
             solver per physics step (its cost grows with them; 1 to 200).
         sole_box_collision: Replace the foot's collision shapes by a box spanning
             the sole rectangle in the derived URDF.
         upper_body_joints: Joints that turn the torso and the arms, used to carry
-            the planner's angular momentum (backend option ``upper_body_momentum``).
+            the planner's angular momentum (the stabilizer's flywheel).
         locked_joints: Joints welded at their standing angle, in the physics URDF
             (:func:`robots.urdf_merge.lock_joints`: fewer degrees of freedom and
             motor rows, so a cheaper physics step) and in the IK (masked); neither
             actuated nor measured. Not the upper-body or leg joints the controller
             moves.
-        backend_options: Keyword arguments of the PyBullet backend tuned for
-            this robot (CoM tracking), see :class:`app.pybullet_backend.PyBulletBackend`.
+        backend_options: This robot's whole-body stabilizer options
+            (:class:`app.stabilizer.config.StabilizerConfig`) and ``control_period``
+            [s], where they differ from the defaults.
     """
 
     name: str
@@ -169,9 +159,8 @@ class RobotDescription:
     com_height: float
     foot_spacing: float
     standing_posture: Mapping[str, float]
-    default_gains: JointGains
+    joint_impedance: Mapping[str, JointImpedance]
     total_mass: float
-    joint_gains: Mapping[str, JointGains] = field(default_factory=dict)
     fall_base_height: float = 0.4
     fall_tilt: float = math.radians(45.0)
     swing_height: float = 0.06
@@ -252,41 +241,8 @@ class RobotDescription:
         object.__setattr__(self, "locked_joints", locked)
         # Freeze the mappings so the description stays immutable and hashable-safe.
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
-        object.__setattr__(self, "joint_gains", MappingProxyType(dict(self.joint_gains)))
-
-    def with_physics_time_step(self, time_step: float) -> RobotDescription:
-        """This description with PyBullet's step ``time_step`` [s] and every position
-        gain scaled by ``time_step / physics_time_step``, so each joint servo keeps its
-        time constant (about dt / kp, see :class:`JointGains`).
-
-        Raises:
-            ParameterError: ``time_step`` is outside [0.0005, 0.005] s, or a scaled
-                gain would exceed 1 (PyBullet's bound; the message names the joint).
-        """
-        _check_physics_time_step(time_step)
-        scale = time_step / self.physics_time_step
-
-        def scaled(joint: str, gains: JointGains) -> JointGains:
-            gain = gains.position_gain * scale
-            if gain > 1.0:
-                raise ParameterError(
-                    f"physics_time_step (position gain of {joint})",
-                    time_step,
-                    f"a step at most {self.physics_time_step / gains.position_gain:g} s, "
-                    "where the scaled gain reaches PyBullet's bound 1",
-                )
-            return dataclasses.replace(gains, position_gain=gain)
-
-        return dataclasses.replace(
-            self,
-            physics_time_step=time_step,
-            default_gains=scaled("the default", self.default_gains),
-            joint_gains={joint: scaled(joint, g) for joint, g in self.joint_gains.items()},
-        )
-
-    def gains_of(self, joint: str) -> JointGains:
-        """PyBullet gains of ``joint`` (its own, else the defaults)."""
-        return self.joint_gains.get(joint, self.default_gains)
+        object.__setattr__(self, "backend_options", MappingProxyType(dict(self.backend_options)))
+        object.__setattr__(self, "joint_impedance", MappingProxyType(dict(self.joint_impedance)))
 
     def ankle_link(self, foot: str) -> str:
         """Ankle link name of ``foot`` (``"left"`` or ``"right"``)."""

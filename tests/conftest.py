@@ -1,15 +1,18 @@
-"""Shared fixtures: planner configurations and LIPM runs, built once per session."""
+"""Shared fixtures and helpers: planner configurations and LIPM runs, built once per
+session; hand-made planner commands and a DCM feedback for full-robot tests (the
+planner's part, without the planner)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
+from numpy.typing import NDArray
 
 from app.lipm_backend import LipmBackend
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, Scenario
-from planner.parameters import PlannerConfig
-from planner.types import Push
+from planner.parameters import GRAVITY, PlannerConfig
+from planner.types import Foothold, MeasuredState, PlannerOutput, Push, StepEvent
 
 
 def scaled(scenario: Scenario, factor: float) -> Scenario:
@@ -30,3 +33,59 @@ def run_lipm(controller: str, scenario: Scenario, qp_solver: str = "proxqp") -> 
 def fig6_runs() -> dict[str, RunResult]:
     """paper-fig6 with each controller."""
     return {c: run_lipm(c, BUILT_IN["paper-fig6"]) for c in ("rsg", "fixed-timing", "no-step")}
+
+
+LEFT = Foothold("left", np.array([0.0, 0.115]))
+RIGHT = Foothold("right", np.array([0.0, -0.115]))
+DCM_GAIN = 3.0  # [1/s] convergence rate of the test's DCM feedback
+
+
+def command(
+    time: float,
+    zmp: NDArray[np.float64],
+    stance: Foothold = LEFT,
+    swing: Foothold = RIGHT,
+    next_step: Foothold | None = None,
+    since_step: float = 0.0,
+    step: StepEvent | None = None,
+    double_support_duration: float = 0.1,
+    step_duration: float = 0.8,
+    angular_momentum_rate: NDArray[np.float64] | None = None,
+    angular_momentum_rate_feedback: NDArray[np.float64] | None = None,
+) -> PlannerOutput:
+    """A planner command: the ZMP ``zmp`` [m] on ``stance``, ``since_step`` [s] after
+    the last step, the next step ``next_step`` (default: ``swing``) at the step
+    duration; hdot [N m] and its feedback part default to zero."""
+    zmp = np.asarray(zmp, float)
+    zero = np.zeros(2)
+    rate = zero if angular_momentum_rate is None else angular_momentum_rate
+    feedback = zero if angular_momentum_rate_feedback is None else angular_momentum_rate_feedback
+    return PlannerOutput(
+        time=time,
+        zmp=zmp,
+        zmp_offset=np.zeros(2),
+        window_center=zmp,
+        angular_momentum_rate=rate,
+        angular_momentum_rate_feedback=feedback,
+        stance=stance,
+        previous_stance=swing,
+        next_step=next_step or swing,
+        next_step_time=time - since_step + step_duration,
+        time_since_step=since_step,
+        double_support=since_step < double_support_duration,
+        dcm_error=np.zeros(2),
+        lyapunov=0.0,
+        lyapunov_at_step=0.0,
+        com_reference=zmp,
+        step=step,
+    )
+
+
+def dcm_feedback_zmp(
+    state: MeasuredState, target: NDArray[np.float64], com_height: float, gain: float = DCM_GAIN
+) -> NDArray[np.float64]:
+    """ZMP [m] that brings the DCM xi = c + cd / omega to ``target`` at the rate ``gain``:
+    xi_dot = omega (xi - p) = -gain (xi - target) (Englsberger et al., IROS 2011)."""
+    omega = np.sqrt(GRAVITY / com_height)
+    dcm = state.com_position + state.com_velocity / omega
+    return dcm + gain / omega * (dcm - np.asarray(target, float))

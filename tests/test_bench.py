@@ -67,16 +67,18 @@ def test_bench_times_the_robot_it_is_given_with_set(
 
 
 def test_tick_breakdown_adds_up_the_parts() -> None:
+    """The controller's time less the IK's is the stabilizer's; the parts add up."""
     from app.bench import tick_breakdown
 
     report = {
         "control_period": 0.01,
         "real_time_factor": 2.0,
         "robot_planner_tick": stats([1e-4, 1e-4]),
-        "backend_timers_mean_per_tick": {
-            "physics": 4e-3, "estimation": 1e-4, "planning": 2e-4, "ik": 2e-4,
-        },
-    }  # fmt: skip
+        "ik": stats([2e-4, 2e-4]),
+        "backend_timers_mean_per_tick": {"physics": 4e-3, "estimation": 1e-4, "control": 5e-4},
+    }
     line = tick_breakdown(report)
-    assert "physics 4.00 ms" in line and "RSG 0.10 ms" in line and "IK 0.20 ms" in line
-    assert "total 4.60 ms" in line and "real-time factor 2.00" in line
+    assert "physics and motors 4.00 ms" in line and "RSG 0.10 ms" in line
+    assert "IK 0.20 ms" in line and "stabilizer, swing foot, feed-forward 0.30 ms" in line
+    assert "measurement and estimation 0.10 ms" in line
+    assert "total 4.70 ms" in line and "real-time factor 2.00" in line

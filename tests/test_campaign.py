@@ -124,7 +124,7 @@ def test_bad_campaigns_name_the_field(change: dict, field: str) -> None:
 
 def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     """A G1 campaign's twin run against ``rsg run --model lipm --robot g1 --push``."""
-    overrides = (("swing_preparation_time", "0.5"), ("cop_feedback", "0,2"))
+    overrides = (("swing_preparation_time", "0.5"), ("landing_depth", "0.004"))
     spec = CampaignSpec(controllers=("rsg", "placo-wpg"), settle=4.0, overrides=overrides)
     twin = spec.twin()
     assert twin is not None and twin.model == "lipm" and twin.robot == "g1"

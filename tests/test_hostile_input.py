@@ -380,7 +380,7 @@ def description_field_cases() -> list[Case]:
     for name in ("physics_time_step=0.001", "solver_iterations=10", "locked_joints=none",
                  "fall_tilt=0.5", "ground_friction=0.8", "swing_height=0.05",
                  "foot_spacing=0.2", "fall_base_height=0.3", "sole_spinning_friction=0",
-                 "cop_admittance=0.2", "control_period=0.005"):  # fmt: skip
+                 "landing_depth=0.004", "control_period=0.005"):  # fmt: skip
         cases.append(set_case(f"pybullet-only-{name}", name, f"--set {name.split('=')[0]}",
                               "only with --model pybullet", robot="g1"))  # fmt: skip
     for pair in ("step_min", "step_max"):
@@ -445,8 +445,8 @@ OVERRIDES = [
     ),
     set_case(
         "backend-option-on-paper-lipm",
-        "cop_admittance=0.2",
-        "--set cop_admittance",
+        "landing_depth=0.004",
+        "--set landing_depth",
         "only with --model pybullet",
     ),
     set_case(
@@ -507,22 +507,20 @@ OVERRIDES = [
         model="pybullet",
     ),
     set_case(
-        "cop-feedback-three",
-        "cop_feedback=1,2,3",
-        "--set cop_feedback",
+        "friction-three",
+        "friction=1,2,3",
+        "--set friction",
         "'1,2,3'",
         model="pybullet",
     ),
+    set_case("friction-100", "friction=100", "--set friction", "[0.1, 2]", model="pybullet"),
     set_case(
-        "cop-feedback-100", "cop_feedback=0,100", "--set cop_feedback", "[0, 50]", model="pybullet"
-    ),
-    set_case(
-        "upper-body-on-talos",
-        "upper_body_momentum=1",
-        "--set upper_body_momentum",
-        "upper_body_joints",
+        "estimator-unknown",
+        "estimator=kalman",
+        "--set estimator",
+        "'kalman'",
+        "truth or odometry",
         model="pybullet",
-        robot="talos",
     ),
     set_case(
         "grid-range", "lqr_zmp_scale=1e-300", "--set lqr_zmp_scale", "'1e-300'", command="grid"
@@ -536,9 +534,9 @@ OVERRIDES = [
     ),
     set_case(
         "grid-backend-option",
-        "com_lookahead=1e300",
-        "--set com_lookahead",
-        "[0, 0.5] s",
+        "landing_depth=1e300",
+        "--set landing_depth",
+        "[0, 0.02]",
         model="pybullet",
         command="grid",
     ),
@@ -905,11 +903,16 @@ BENCH = [
     bench_case("robot-unknown", ["--robot", "atlas"], "robot='atlas'"),
     bench_case(
         "set-with-no-robot",
-        ["--no-robot", "--set", "cop_admittance=0.2"],
-        "--set='cop_admittance=0.2'",
+        ["--no-robot", "--set", "landing_depth=0.004"],
+        "--set='landing_depth=0.004'",
         "--no-robot",
     ),
-    bench_case("set-out-of-range", ["--set", "cop_admittance=5"], "--set cop_admittance", "[0, 2]"),
+    bench_case(
+        "set-out-of-range",
+        ["--set", "landing_depth=5"],
+        "--set landing_depth",
+        "[0, 0.02]",
+    ),
     bench_case("set-unknown", ["--set", "bogus=1"], "--set='bogus'"),
 ]
 

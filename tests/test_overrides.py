@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from app.robot_setup import build_robot_backend, robot_with_overrides
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
 from app.setup import build_backend
+from app.stabilizer.config import OPTION_NAMES
 from app.sweep import SweepSpec, run_sweep
 from planner.exceptions import ParameterError
 from planner.types import Push
@@ -48,8 +50,8 @@ def test_values_are_parsed_by_the_kind_of_the_parameter() -> None:
 
 
 def test_assignments_need_a_name_and_a_value() -> None:
-    assert parse_assignment(" cop_admittance = 0.2 ") == ("cop_admittance", "0.2")
-    for text in ("cop_admittance", "=0.2", "cop_admittance="):
+    assert parse_assignment(" landing_depth = 0.003 ") == ("landing_depth", "0.003")
+    for text in ("landing_depth", "=0.003", "landing_depth="):
         with pytest.raises(argparse.ArgumentTypeError):
             parse_assignment(text)
 
@@ -58,29 +60,36 @@ def test_each_name_goes_where_it_applies() -> None:
     parsed = parse_overrides(
         (
             ("swing_preparation_time", "0.3"),
-            ("cop_feedback", "0,1"),
-            ("foothold_feedback", "false"),
+            ("landing_depth", "0.003"),
+            ("estimator", "odometry"),
+            ("control_period", "0.004"),
             ("crossing_margin", "0.03"),
         )
     )
     assert parsed.description == {"swing_preparation_time": 0.3}
-    assert parsed.backend == {"cop_feedback": (0.0, 1.0), "foothold_feedback": False}
+    assert parsed.backend == {
+        "landing_depth": 0.003,
+        "estimator": "odometry",
+        "control_period": 0.004,
+    }
     assert parsed.rsg == {"crossing_margin": 0.03}
+    # Every stabilizer option may be set on the full robot.
+    assert set(OPTION_NAMES) <= set(allowed_names("pybullet"))
     # On the LIPM only RSG parameters exist, all of them.
     lipm = parse_overrides((("swing_preparation_time", "0.3"),), "lipm")
     assert lipm.rsg == {"swing_preparation_time": 0.3}
-    assert "cop_admittance" not in allowed_names("lipm")
+    assert "landing_depth" not in allowed_names("lipm")
 
 
 @pytest.mark.parametrize(
     ("overrides", "model", "field"),
     [
         ((("no_such_parameter", "1"),), "pybullet", "--set"),
-        ((("cop_admittance", "0.2"),), "lipm", "--set cop_admittance"),  # PyBullet only
+        ((("landing_depth", "0.004"),), "lipm", "--set landing_depth"),  # PyBullet
         ((("step_width", "0.3"),), "lipm", "--set"),  # the paper's LIPM: RSG parameters
         ((("crossing_margin", "0.03"), ("crossing_margin", "0.04")), "lipm",
          "--set crossing_margin"),
-        ((("cop_feedback", "1,2,3"),), "pybullet", "--set cop_feedback"),
+        ((("friction", "1,2,3"),), "pybullet", "--set friction"),
     ],
 )  # fmt: skip
 def test_bad_overrides_name_the_parameter(overrides: tuple, model: str, field: str) -> None:
@@ -92,13 +101,14 @@ def test_bad_overrides_name_the_parameter(overrides: tuple, model: str, field: s
 
 
 def test_a_robot_description_takes_fields_and_backend_options() -> None:
+    tuned = dataclasses.replace(get_robot("g1"), backend_options={"landing_depth": 0.004})
     description, _ = robot_with_overrides(
-        "g1", (("swing_preparation_time", "0.3"), ("cop_admittance", "0.2"))
+        tuned, (("swing_preparation_time", "0.3"), ("landing_depth", "0.004"))
     )
     assert description.swing_preparation_time == 0.3
-    assert description.backend_options["cop_admittance"] == 0.2
-    # The other tuned options are kept.
-    assert description.backend_options["cop_feedback"] == (0.0, 2.0)
+    assert description.backend_options["landing_depth"] == 0.004
+    # The description's own options are kept.
+    assert description.backend_options["landing_depth"] == 0.004
     with pytest.raises(ParameterError) as error:
         robot_with_overrides("g1", (("com_height", "5"),))
     assert error.value.field == "com_height"  # the description's own range check
@@ -108,10 +118,20 @@ def test_the_robot_backend_and_planner_receive_the_overrides() -> None:
     backend, config, _ = build_robot_backend(
         "g1",
         "rsg",
-        (("swing_preparation_time", "0.3"), ("cop_admittance", "0.2"), ("crossing_margin", "0.03")),
+        (
+            ("swing_preparation_time", "0.3"),
+            ("landing_depth", "0.004"),
+            ("estimator", "odometry"),
+            ("control_period", "0.004"),
+            ("crossing_margin", "0.03"),
+        ),
     )
     try:
-        assert backend.cop_admittance == 0.2
+        stabilizer = backend.controller.config
+        assert stabilizer.landing_depth == 0.004 and stabilizer.estimator == "odometry"
+        assert backend.controller.landing.depth == 0.004
+        assert backend.controller.estimator.source == "odometry"
+        assert backend.control_period == 0.004 == backend.controller.period
         assert config.rsg.swing_preparation_time == 0.3
         assert backend.timing.ready == 0.3  # the swing foot is timed on the same T_SP
         assert config.rsg.crossing_margin == 0.03
@@ -156,10 +176,10 @@ def test_the_run_command_records_the_overrides(tmp_path: Path, capsys) -> None:
 
 
 def test_a_bad_override_is_a_clear_error_before_any_run(tmp_path: Path, capsys) -> None:
-    code = main(["grid", "--model", "lipm", "--set", "cop_admittance=0.2", "--out", str(tmp_path)])
+    code = main(["grid", "--model", "lipm", "--set", "landing_depth=0.004", "--out", str(tmp_path)])
     assert code == 2
     err = capsys.readouterr().err
-    assert "--set cop_admittance" in err and "only with --model pybullet" in err
+    assert "--set landing_depth" in err and "only with --model pybullet" in err
     assert not (tmp_path / "grid.json").exists()
     with pytest.raises(ParameterError):
         GridSpec(overrides=(("swing_preparation_time", "soon"),))
@@ -219,13 +239,13 @@ def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
     _, paper, _ = build_backend("lipm", None, "rsg")
     assert paper.model.mass != pytest.approx(g1.total_mass)
     with pytest.raises(ParameterError) as error:
-        build_backend("lipm", "g1", "rsg", overrides=(("cop_admittance", "0.2"),))
-    assert error.value.field == "--set cop_admittance"
+        build_backend("lipm", "g1", "rsg", overrides=(("landing_depth", "0.004"),))
+    assert error.value.field == "--set landing_depth"
     assert "only with --model pybullet" in error.value.allowed
     with pytest.raises(ParameterError) as error:
         build_backend("lipm", "g1", "rsg", overrides=(("no_such_name", "0.2"),))
     assert "swing_preparation_time" in error.value.allowed
-    assert "cop_admittance" not in error.value.allowed
+    assert "landing_depth" not in error.value.allowed
     assert "swing_preparation_time" in allowed_names("lipm", "g1")
     assert (
         "swing_preparation_time"
@@ -288,9 +308,9 @@ def test_the_solver_iterations_reach_pybullet() -> None:
 
 def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
     """``--set physics_time_step=0.001`` runs G1's physics at 1 kHz instead of 500 Hz:
-    PyBullet's fixed step, the simulated time per step, the steps per control tick and
-    the position gains (halved: the same servo time constants) follow. A step that
-    does not divide the control period is an error naming it before any run."""
+    PyBullet's fixed step, the simulated time per step and the motors' stable PD
+    step (:mod:`app.joint_motors`) follow. A step that does not divide the control
+    period is an error naming it before any run."""
     from app.pybullet_robot import SimulatedRobot
 
     g1 = get_robot("g1")
@@ -298,8 +318,6 @@ def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
         overrides = () if text is None else (("physics_time_step", text),)
         description, _ = robot_with_overrides("g1", overrides, "pybullet")
         assert description.physics_time_step == step
-        knee = description.gains_of("left_knee_joint").position_gain
-        assert knee == pytest.approx(g1.gains_of("left_knee_joint").position_gain * step / 0.002)
         robot = SimulatedRobot(description)
         try:
             assert robot.client.getPhysicsEngineParameters()["fixedTimeStep"] == step
@@ -310,7 +328,7 @@ def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
             robot.close()
         backend, config, initial = build_robot_backend("g1", "rsg", overrides=overrides)
         try:
-            assert backend._substeps == round(backend.control_period / step)
+            assert backend.sim.time_step == backend.sim.motors.time_step == step
             result = run_closed_loop(backend, config, Scenario("walk", 0.1), initial)
             assert not result.fall.fell
             assert backend.sim.time == pytest.approx(0.1)  # ticks x substeps x step

@@ -233,7 +233,6 @@ def test_talos_description_validates_and_names_joints_of_its_urdf():
     root = ET.parse(derived_urdf(talos)).getroot()
     joints = {joint.get("name") for joint in root.findall("joint") if joint.get("type") != "fixed"}
     assert set(talos.standing_posture) <= joints
-    assert set(talos.joint_gains) <= joints
 
 
 def test_talos_derived_urdf_has_sole_frames_under_the_ankles_and_resolved_meshes():
@@ -273,72 +272,3 @@ def test_physics_time_step_is_validated(value):
     with pytest.raises(ParameterError) as error:
         dataclasses.replace(get_robot("g1"), physics_time_step=value)
     assert error.value.field == "physics_time_step"
-    with pytest.raises(ParameterError) as error:
-        get_robot("g1").with_physics_time_step(value)
-    assert error.value.field == "physics_time_step"
-
-
-ONE_JOINT_ARM = """<robot name="arm">
-  <link name="base"><inertial><mass value="1"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <link name="arm"><inertial><origin xyz="0.2 0 0"/><mass value="2"/>
-    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
-  <joint name="j" type="revolute"><parent link="base"/><child link="arm"/>
-    <axis xyz="0 0 1"/><limit lower="-3" upper="3" effort="1000" velocity="100"/></joint>
-</robot>"""
-
-
-def _servo_time_constant(urdf: Path, time_step: float, position_gain: float) -> float:
-    """Time [s] a PyBullet position servo (kd 1) takes to close 63 % of a 0.1 rad step."""
-    import pybullet
-    from pybullet_utils.bullet_client import BulletClient
-
-    client = BulletClient(connection_mode=pybullet.DIRECT)
-    try:
-        client.setTimeStep(time_step)
-        body = client.loadURDF(str(urdf), useFixedBase=True)
-        client.setJointMotorControl2(
-            body,
-            0,
-            pybullet.POSITION_CONTROL,
-            targetPosition=0.1,
-            targetVelocity=0.0,
-            positionGain=position_gain,
-            velocityGain=1.0,
-            force=1000.0,
-        )
-        for step in range(1, 1000):
-            client.stepSimulation()
-            if client.getJointState(body, 0)[0] >= 0.1 * (1.0 - np.exp(-1.0)):
-                return step * time_step
-        raise AssertionError("the servo did not reach 63 % within 1000 steps")
-    finally:
-        client.disconnect()
-
-
-def test_a_new_physics_time_step_keeps_each_servo_time_constant(tmp_path):
-    """PyBullet's position gain is per step (servo time constant dt / kp);
-    ``with_physics_time_step`` scales the gains so each joint servo of G1 (2 ms)
-    responds at 1 ms as fast as before, which a one-joint arm in PyBullet shows."""
-    g1 = get_robot("g1")
-    fine = g1.with_physics_time_step(0.001)
-    assert fine.physics_time_step == 0.001 and g1.physics_time_step == 0.002
-    urdf = tmp_path / "arm.urdf"
-    urdf.write_text(ONE_JOINT_ARM)
-    for joint in ("left_knee_joint", "left_ankle_roll_joint", "waist_yaw_joint"):
-        before, after = g1.gains_of(joint), fine.gains_of(joint)
-        assert after.position_gain == pytest.approx(before.position_gain / 2)
-        assert (after.velocity_gain, after.max_force) == (before.velocity_gain, before.max_force)
-        coarse_tau = _servo_time_constant(urdf, 0.002, before.position_gain)
-        fine_tau = _servo_time_constant(urdf, 0.001, after.position_gain)
-        assert coarse_tau == pytest.approx(0.002 / before.position_gain, abs=0.002)
-        assert fine_tau == pytest.approx(coarse_tau, abs=0.002)
-    # G1's legs reach PyBullet's bound (kp 1) at 5 ms; a stiffer joint cannot go there.
-    assert g1.with_physics_time_step(0.005).gains_of("left_knee_joint").position_gain == 1.0
-    stiff = dataclasses.replace(
-        g1, default_gains=dataclasses.replace(g1.default_gains, position_gain=0.8)
-    )
-    with pytest.raises(ParameterError) as error:
-        stiff.with_physics_time_step(0.004)
-    assert error.value.field == "physics_time_step (position gain of the default)"
-    assert error.value.value == 0.004

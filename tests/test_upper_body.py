@@ -10,10 +10,10 @@ import pytest
 
 from app.backend import InitialCondition
 from app.pybullet_backend import PyBulletBackend
+from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
-from planner.types import Foothold, PlannerOutput
 from robots import get_robot
 
 DT = 0.01
@@ -136,42 +136,54 @@ def test_the_flywheel_checks_its_parameters(ik):
         UpperBodyFlywheel(ik.robot, ["waist_roll_joint"], np.zeros(1), cancel=1.5)
 
 
-def test_a_robot_without_upper_body_joints_cannot_carry_momentum():
-    talos = dataclasses.replace(get_robot("talos"), upper_body_joints=())
-    with pytest.raises(ParameterError, match="upper_body_momentum.*upper_body_joints"):
-        PyBulletBackend(talos, upper_body_momentum=1.0)
+def test_a_robot_without_upper_body_joints_has_no_flywheel():
+    """Talos names no upper-body joints: its controller leaves the whole hdot to the CoP
+    (no flywheel, no upper-body task in its IK), whatever ``flywheel_momentum`` says."""
+    from app.stabilizer.config import StabilizerConfig
+    from app.stabilizer.controller import WholeBodyController
+    from kinematics.swing_foot import SwingTiming
+
+    talos = get_robot("talos")
+    assert talos.upper_body_joints == ()
+    controller = WholeBodyController(
+        talos, SwingTiming(), 0.01, StabilizerConfig(flywheel_momentum=1.0)
+    )
+    assert controller.flywheel is None
+    assert list(controller.ik.upper_body_joints) == []
 
 
 def test_in_pybullet_the_waist_turns_with_a_pulse_of_hdot_and_comes_back():
     """The planner's feedback hdot (3 N m about y for 0.2 s) turns G1's waist, which
-    then returns; the plan itself has no hdot, so only the upper body carries it."""
-    left = Foothold("left", np.array([0.0, 0.115]))
-    right = Foothold("right", np.array([0.0, -0.115]))
-    backend = PyBulletBackend("g1", upper_body_momentum=1.0, upper_body_return_time=0.5)
+    then returns; the plan itself has no hdot, so only the upper body carries it, and
+    the CoP the feet are given moves against the waist's Ldot (cop = r + H Ldot / (m g),
+    :mod:`app.stabilizer.centroidal`; measured up to 4.5 mm back), so the CoM stays
+    over the feet."""
+    robot = dataclasses.replace(
+        G1, backend_options={"flywheel_momentum": 1.0, "flywheel_return_time": 0.5}
+    )
+    backend = PyBulletBackend(robot)
     try:
-        backend.reset(InitialCondition(left, right, np.zeros(2), np.zeros(2)))
-        pitches, coms = [], []
-        for tick in range(300):
+        state = backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
+        pitches, coms, shifts = [], [], []
+        for tick in range(200):
             time = tick * backend.control_period
             rate = np.array([0.0, 3.0]) if 0.5 <= time < 0.7 else np.zeros(2)
-            command = PlannerOutput(
-                time=time, zmp=np.zeros(2), zmp_offset=np.zeros(2), window_center=np.zeros(2),
-                angular_momentum_rate=np.zeros(2), angular_momentum_rate_feedback=rate,
-                stance=left, previous_stance=right, next_step=right, next_step_time=time + 0.8,
-                time_since_step=0.0, double_support=True, dcm_error=np.zeros(2), lyapunov=0.0,
-                lyapunov_at_step=0.0, com_reference=np.zeros(2), step=None,
-            )  # fmt: skip
-            state = backend.step(command, np.zeros(2))
+            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.com_height)
+            out = command(time, zmp, angular_momentum_rate_feedback=rate)
+            state = backend.step(out, np.zeros(2))
             pitches.append(backend.sim.joint_angles()["waist_pitch_joint"])  # stands at 0
             coms.append(state.com_position)
+            shifts.append(backend.planned_cop - zmp)
         assert not backend.fall_status().fell
     finally:
         backend.close()
-    pitches = np.array(pitches)
+    pitches, shifts = np.array(pitches), np.array(shifts)
     quiet = np.abs(pitches[:50]).max()
     turned = pitches[50:90]
     # The same sign as the offsets that carry +y momentum (waist pitch column of A > 0).
     assert turned.max() > 0.03 and turned.max() > 10 * quiet
-    assert abs(pitches[-1]) < 0.5 * turned.max()  # returning (with an undershoot)
-    # The CoP plan accounts for the waist's Ldot: the CoM stays over the feet.
-    assert np.abs(np.array(coms)).max() < 0.01
+    assert abs(pitches[-1]) < 0.5 * turned.max()  # returning
+    # +y momentum growing: the CoP moves back (-x), by H Ldot / (m g).
+    assert shifts[50:90, 0].min() < -0.002
+    assert np.abs(shifts[50:90, 1]).max() < 0.2 * np.abs(shifts[50:90, 0]).max()
+    assert np.abs(np.array(coms)).max() < 0.005

@@ -1,0 +1,64 @@
+"""What the feet must do for the CoM to move as the planner's pendulum.
+
+The planner commands a ZMP p and a rate of angular momentum hdot; on its LIPM
+they act together as the pivot (centroidal moment pivot, CMP) r = p - H hdot / (m g),
+H = [[0, -1], [1, 0]] of (1), and the CoM accelerates as
+
+    m cdd = m omega^2 (c - r)       (horizontal),      vertical force m g.
+
+On the robot the ground's centre of pressure and the body's own angular momentum
+rate Ldot together make the pivot: r = cop - H Ldot / (m g). So the CoP that realises
+the planner's pivot while the body moves with Ldot is
+
+    cop = r + H Ldot / (m g),
+
+and it must lie on the support: clipped to the stance sole in single support; in
+double support the wrench distribution (:mod:`app.stabilizer.wrench_distribution`)
+keeps it in the hull of the two soles. Ldot is that of the whole-body motion the IK
+plans (legs and the upper-body flywheel, :mod:`kinematics.upper_body`), so the
+flywheel's share of hdot takes load off the CoP. (Popovic, Goswami and Herr, "Ground
+reference points in legged locomotion", IJRR 2005, for the CMP.)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from planner.hybrid_lipm import H_MATRIX
+from planner.parameters import GRAVITY, LipmModel
+from robots.description import SoleRectangle
+
+
+def pivot(
+    zmp: NDArray[np.float64], angular_momentum_rate: NDArray[np.float64], mass: float
+) -> NDArray[np.float64]:
+    """The planner's pivot r = p - H hdot / (m g) [m], shape (2,)."""
+    return zmp - H_MATRIX @ angular_momentum_rate / (mass * GRAVITY)
+
+
+def centre_of_pressure(
+    pivot_point: NDArray[np.float64],
+    motion_momentum_rate: NDArray[np.float64],
+    mass: float,
+    stance: NDArray[np.float64],
+    sole: SoleRectangle,
+    double_support: bool,
+) -> NDArray[np.float64]:
+    """CoP [m] that realises ``pivot_point`` while the body's angular momentum changes
+    at ``motion_momentum_rate`` [N m]; clipped to the stance sole (at ``stance``
+    [m], no yaw) in single support."""
+    cop = pivot_point + H_MATRIX @ motion_momentum_rate / (mass * GRAVITY)
+    if double_support:
+        return cop
+    low = stance + np.array([sole.x_min, -sole.half_width])
+    high = stance + np.array([sole.x_max, sole.half_width])
+    return np.minimum(np.maximum(cop, low), high)
+
+
+def contact_force(
+    model: LipmModel, com: NDArray[np.float64], pivot_point: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Net ground force [N], shape (3,): the LIPM's m omega^2 (c - r) and m g."""
+    horizontal = model.mass * model.omega**2 * (np.asarray(com, float) - pivot_point)
+    return np.array([horizontal[0], horizontal[1], model.mass * model.gravity])

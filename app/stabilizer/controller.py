@@ -1,0 +1,317 @@
+"""The whole-body controller: one control tick from the measurement to the joint command.
+
+    measure -> (plan: the RSG, outside) -> stabilize -> swing foot -> IK -> actuate
+
+* measure: the state estimate (:mod:`.estimator`) from the measurement record;
+* stabilize: the pivot the planner commands, the CoP and net force that realise it
+  (:mod:`.centroidal`), shared among the feet on the ground (:mod:`.wrench_distribution`);
+* swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
+* IK: placo's whole-body IK, with the upper body as a flywheel for hdot
+  (:mod:`kinematics.upper_body`);
+* actuate: per joint a target, stiffness, damping and the feed-forward torque from
+  inverse dynamics of the planned motion with the planned contact wrenches.
+
+The design, loop by loop, with its references and measurements: docs/full-robot.md.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from kinematics.robot_model import RobotModel
+from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
+from kinematics.upper_body import UpperBodyFlywheel
+from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
+from planner.exceptions import ParameterError
+from planner.hybrid_lipm import integrate_lipm
+from planner.parameters import GRAVITY, LipmModel
+from planner.types import Foot, MeasuredState, PlannerOutput, other_foot
+from robots.description import RobotDescription
+
+from ..lowlevel import JointCommand, RobotMeasurement
+from . import centroidal
+from .config import StabilizerConfig
+from .estimator import RobotState, StateEstimator
+from .landing import Landing
+from .wrench_distribution import ContactLimits, FootContact, distribute_wrench
+
+CONTACT_LOAD = 0.05  # [-, of m g] a foot carrying more is on the ground
+ACCELERATION_FILTER = 0.02  # [s] low-pass of the IK's joint accelerations
+ACCELERATION_LIMIT = 50.0  # [rad/s^2] bound on the feed-forward joint accelerations
+MOMENTUM_FILTER = 0.05  # [s] low-pass of the IK motion's angular momentum rate
+SWING_ACCELERATION = 20.0  # [m/s^2] bound on the swing sole's re-planned approach
+SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
+
+
+class WholeBodyController:
+    """Joint commands that make a biped follow the RSG's commands.
+
+    Args:
+        description: The robot.
+        timing: The planner's step timing (for the swing foot).
+        control_period: [s].
+        config: Options.
+
+    Attributes:
+        model: The robot's rigid-body model, holding the current state estimate.
+        expected_contact_force: J^T f of the contact wrenches planned at the last
+            tick [N, N m] (what the feed-forward torques are computed for).
+        planned_cop: The CoP the feet were asked for at the last tick [m].
+        ik_failure: Why the IK had no solution, once it had none.
+    """
+
+    def __init__(
+        self,
+        description: RobotDescription,
+        timing: SwingTiming,
+        control_period: float,
+        config: StabilizerConfig,
+    ) -> None:
+        self.description = description
+        self.config = config
+        self.period = control_period
+        self.model = RobotModel(description)
+        self.mass = self.model.mass
+        self.lipm = LipmModel(mass=self.mass, com_height=description.com_height)
+        self.estimator = StateEstimator(self.model, config.estimator)
+        flywheel = config.flywheel_momentum > 0.0 and bool(description.upper_body_joints)
+        self.ik = WholeBodyIK(description, upper_body=flywheel)
+        self._ik_order = np.array([self.ik.joint_names.index(n) for n in self.model.joint_names])
+        self.flywheel = None
+        if flywheel:
+            self.flywheel = UpperBodyFlywheel(
+                self.ik.robot,
+                self.ik.upper_body_joints,
+                self.ik.upper_body_posture,
+                return_time=config.flywheel_return_time,
+                max_momentum=config.flywheel_momentum,
+                cancel=config.flywheel_cancel,
+            )
+        self.swing = SwingFootTrajectory(
+            timing,
+            apex_height=description.swing_height,
+            max_acceleration=SWING_ACCELERATION,
+            descent_slope=SWING_DESCENT_SLOPE,
+            land_on_time=True,
+        )
+        self.landing = Landing(config.landing_depth, timing.double_support)
+        self.limits = ContactLimits(description.sole, friction=config.friction)
+        self.stiffness, self.damping = joint_impedance(self.model, description)
+        self._ankle_height = -float(description.sole_offset[2])
+        self.expected_contact_force = np.zeros(self.model.nv)
+        self.state: RobotState | None = None
+        self._reset_state(np.zeros(2))
+
+    @property
+    def timing(self) -> SwingTiming:
+        return self.swing.timing
+
+    @timing.setter
+    def timing(self, value: SwingTiming) -> None:
+        self.swing.timing = value
+        self.landing.double_support = value.double_support
+
+    def _reset_state(self, com_xy: NDArray[np.float64]) -> None:
+        self._stance: Foot = "left"
+        self._targets: tuple[NDArray[np.float64], NDArray[np.float64]] = (
+            np.zeros(len(self.model.joint_names)),
+        ) * 2
+        self._acceleration = np.zeros(len(self.model.joint_names))
+        self._ik_momentum: NDArray[np.float64] | None = None
+        self._motion_momentum_rate = np.zeros(2)
+        self._stance_yaw = 0.0
+        self.planned_cop = np.array(com_xy, dtype=float)
+        self.ik_failure: str | None = None
+        self._contacts: list[FootContact] = []
+
+    def reset(
+        self,
+        soles: dict[Foot, NDArray[np.float64]],
+        stance: Foot,
+        com_xy: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """Stand on ``soles`` (4x4 poses) with the CoM above ``com_xy`` [m].
+
+        Returns:
+            The IK's joint angles [rad] in the model's joint order.
+        """
+        self._reset_state(np.asarray(com_xy, float))
+        self.estimator.reset()
+        self._stance = stance
+        q = self.ik.reset(soles["left"], soles["right"], com_xy)[self._ik_order]
+        self.swing.start(soles[other_foot(stance)][:2, 3])
+        if self.flywheel is not None:
+            self.flywheel.reset()
+        self._targets = (q, q)
+        return q
+
+    # ------------------------------------------------------------------- tick
+    def tick(self, measurement: RobotMeasurement, command: PlannerOutput) -> JointCommand:
+        """One control tick: the joint command for ``command`` given ``measurement``."""
+        dt = self.period
+        stance: Foot = command.stance.foot
+        swing: Foot = other_foot(stance)
+        state = self._estimate(measurement, command)  # measure
+        if stance != self._stance:  # the planner stepped: the old stance foot lifts off
+            self._start_swing(stance, swing)
+        # stabilize
+        pivot = centroidal.pivot(command.zmp, command.angular_momentum_rate, self.mass)
+        self.planned_cop = centroidal.centre_of_pressure(
+            pivot,
+            self._motion_momentum_rate,
+            self.mass,
+            np.asarray(command.stance.position, float),
+            self.description.sole,
+            command.double_support,
+        )
+        force = centroidal.contact_force(self.lipm, state.com[:2], pivot)
+        com_target, _ = integrate_lipm(
+            self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
+        )
+        # swing foot
+        soles = self._sole_targets(command, stance, swing)
+        # IK
+        q = self._solve_ik(command, com_target, soles)
+        # actuate: feed-forward torques for the contact wrenches the feet are given
+        feet, wrenches = self._contact_wrenches(command, measurement, force)
+        torque = self._feedforward(feet, wrenches)
+        velocity = (q - self._targets[0]) / dt
+        self._targets = (q, self._targets[0])
+        return JointCommand(q, velocity, self.stiffness, self.damping, torque)
+
+    # ----------------------------------------------------------- the stages
+    def _estimate(self, measurement: RobotMeasurement, command: PlannerOutput) -> RobotState:
+        """The estimate of ``measurement`` (made by :meth:`observe` unless it is new)."""
+        if self.state is None or self.state.time != measurement.time:
+            self.observe(measurement, command.stance.foot, command.double_support)
+        assert self.state is not None  # set by observe()
+        return self.state
+
+    def _start_swing(self, stance: Foot, swing: Foot) -> None:
+        self.swing.start(self.model.sole_frame(swing)[0][:2])
+        _, rotation = self.model.sole_frame(stance)
+        self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+        self._stance = stance
+
+    def _sole_targets(
+        self, command: PlannerOutput, stance: Foot, swing: Foot
+    ) -> dict[Foot, NDArray[np.float64]]:
+        """4x4 targets of both soles: the stance sole on the planner's foothold, the
+        swing sole on its trajectory to the announced step, with the landing rules."""
+        dt = self.period
+        time_since_step = command.time_since_step + dt
+        landing_time = command.next_step_time - (command.time - command.time_since_step)
+        position = self.swing.update(
+            time_since_step, np.asarray(command.next_step.position, float), dt, landing_time
+        )
+        stance_height = 0.0
+        if command.double_support:
+            stance_height = self.landing.stance_height(time_since_step)
+        else:
+            position[2] = self.landing.swing_height(position[2], landing_time - time_since_step)
+        foothold = np.array([*command.stance.position, stance_height])
+        return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position)}
+
+    def _solve_ik(
+        self,
+        command: PlannerOutput,
+        com_target: NDArray[np.float64],
+        soles: dict[Foot, NDArray[np.float64]],
+    ) -> NDArray[np.float64]:
+        """Joint targets [rad]; the IK motion's angular momentum rate is kept for the CoP."""
+        dt = self.period
+        support = "both" if command.double_support else command.stance.foot
+        offsets = None
+        if self.flywheel is not None:
+            rest = self.ik.angular_momentum[:2] - self.flywheel.momentum
+            offsets = self.flywheel.follow_rate(command.angular_momentum_rate_feedback, dt, rest)
+        try:
+            q = self.ik.solve(
+                com_target, soles["left"], soles["right"], support, dt, upper_body_offsets=offsets
+            )[self._ik_order]
+        except IkInfeasibleError as error:
+            # Seen only while falling: hold the last targets and report the fall.
+            self.ik_failure = (
+                f"whole-body IK infeasible at t = {command.time:.2f} s ({error.reason})"
+            )
+            q = self._targets[0]
+        momentum = self.ik.angular_momentum[:2].copy()
+        previous = momentum if self._ik_momentum is None else self._ik_momentum
+        self._ik_momentum = momentum
+        self._motion_momentum_rate += min(dt / MOMENTUM_FILTER, 1.0) * (
+            (momentum - previous) / dt - self._motion_momentum_rate
+        )
+        raw = (q - 2.0 * self._targets[0] + self._targets[1]) / dt**2
+        raw = np.minimum(np.maximum(raw, -ACCELERATION_LIMIT), ACCELERATION_LIMIT)
+        self._acceleration += min(dt / ACCELERATION_FILTER, 1.0) * (raw - self._acceleration)
+        return q
+
+    def _contact_wrenches(
+        self, command: PlannerOutput, measurement: RobotMeasurement, force: NDArray[np.float64]
+    ) -> tuple[list[Foot], list[NDArray[np.float64]]]:
+        """The planned supports that touch the ground (else the feet that do; in the
+        air, the stance foot) and the wrench each is given."""
+        threshold = CONTACT_LOAD * self.mass * GRAVITY
+        planned: list[Foot] = ["left", "right"] if command.double_support else [command.stance.foot]
+        touching: list[Foot] = [
+            f for f in ("left", "right") if measurement.normal_force(f) > threshold
+        ]
+        feet = [f for f in planned if f in touching] or touching or [command.stance.foot]
+        contacts = []
+        for foot in feet:
+            position, rotation = self.model.sole_frame(foot)
+            yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+            ground_point = np.array([position[0], position[1], 0.0])
+            contacts.append(FootContact(ground_point, yaw, self._ankle_height))
+        wrenches = distribute_wrench(contacts, force, self.planned_cop, self.limits)
+        self._contacts = contacts
+        return feet, wrenches
+
+    def _feedforward(
+        self, feet: list[Foot], wrenches: list[NDArray[np.float64]]
+    ) -> NDArray[np.float64]:
+        """tau_ff = M a + h - J^T f [N m] for the IK's accelerations and the wrenches."""
+        model = self.model
+        acceleration = np.zeros(model.nv)
+        acceleration[6:] = self._acceleration
+        generalized = model.inverse_dynamics(acceleration)
+        self.expected_contact_force = np.zeros(model.nv)
+        for foot, contact, wrench in zip(feet, self._contacts, wrenches, strict=True):
+            self.expected_contact_force += model.wrench_generalized_force(
+                foot, contact.sole_point, wrench
+            )
+        return (generalized - self.expected_contact_force)[6:]
+
+    # ---------------------------------------------------------- observation
+    def observe(
+        self, measurement: RobotMeasurement, stance: Foot, double_support: bool
+    ) -> MeasuredState:
+        """Estimate the state from ``measurement``; return what the planner reads: the
+        CoM, its velocity and, in single support, the stance sole (the planner
+        re-anchors its foothold there)."""
+        self.state = state = self.estimator.update(measurement, stance)
+        sole = None
+        loaded = measurement.normal_force(stance) > CONTACT_LOAD * self.mass * GRAVITY
+        if not double_support and loaded:
+            sole = self.model.sole_frame(stance)[0][:2].copy()
+        return MeasuredState(
+            state.time, state.com[:2].copy(), state.com_velocity[:2].copy(), None, sole
+        )
+
+
+def joint_impedance(
+    model: RobotModel, description: RobotDescription
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Per-joint stiffness [N m/rad] and damping [N m s/rad] in the model's joint order.
+
+    Raises:
+        ParameterError: A joint of the model has no gains in the description.
+    """
+    missing = [name for name in model.joint_names if name not in description.joint_impedance]
+    if missing:
+        raise ParameterError(
+            "joint_impedance", missing, f"gains for every joint of {description.name}"
+        )
+    gains = [description.joint_impedance[name] for name in model.joint_names]
+    return np.array([g.stiffness for g in gains]), np.array([g.damping for g in gains])

@@ -1,0 +1,47 @@
+"""Landing: the swing sole's last centimetres and the new stance sole's first moments.
+
+Two rules on the height of the sole targets given to the IK:
+
+* contact by the planned time: over the last ``WINDOW`` before the planner's landing
+  time the swing sole's target sinks to ``depth`` below the ground, so that a sole
+  tracking a few millimetres high still touches down by the step (a late touchdown
+  leaves the CoP on the old foot while the planner has moved it to the new one);
+* continuity at the step: the new stance sole's target starts where the swing
+  sole's last target was and reaches the ground by the end of the double support
+  (a target that jumped there in one tick kicked the old foot off the ground: 2.6 m g
+  on the feet and 20 ms in the air at every step, measured on G1).
+"""
+
+from __future__ import annotations
+
+WINDOW = 0.1  # [s] before the planned landing over which the target sinks
+
+
+class Landing:
+    """Height offsets of the feet's targets around a step.
+
+    Args:
+        depth: Depth below the ground the swing sole aims at at the landing time [m].
+        double_support: T_DSP, over which the new stance sole settles [s].
+    """
+
+    def __init__(self, depth: float, double_support: float) -> None:
+        self.depth = depth
+        self.double_support = double_support
+        self._last_height = 0.0  # [m] the swing sole's last target height
+
+    def swing_height(self, profile: float, time_to_landing: float) -> float:
+        """Target height [m] of the swing sole.
+
+        Args:
+            profile: The swing trajectory's height [m].
+            time_to_landing: Time left until the planned landing [s].
+        """
+        sink = self.depth * min(max(1.0 - time_to_landing / WINDOW, 0.0), 1.0)
+        self._last_height = profile - sink
+        return self._last_height
+
+    def stance_height(self, time_since_step: float) -> float:
+        """Target height [m] of the new stance sole in the double support after a step."""
+        remaining = max(0.0, 1.0 - time_since_step / self.double_support)
+        return self._last_height * remaining

@@ -1,0 +1,98 @@
+"""The pivot, the CoP and the net force that make the CoM move as the planner's LIPM
+(:mod:`app.stabilizer.centroidal`), checked by moment balance about the CoM."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from app.stabilizer.centroidal import centre_of_pressure, contact_force, pivot
+from planner.parameters import GRAVITY, LipmModel
+from robots import get_robot
+
+MODEL = LipmModel(mass=33.3, com_height=0.66)
+SOLE = get_robot("g1").sole
+RNG_SEED = 22
+
+
+def cases(count: int = 50):
+    """Random CoM [m], ZMP [m] and angular momentum rate [N m] (seeded)."""
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(count):
+        com = rng.uniform(-0.1, 0.1, 2)
+        yield com, com + rng.uniform(-0.05, 0.05, 2), rng.uniform(-5.0, 5.0, 2)
+
+
+def moment_about_com(point, com, force):
+    """Horizontal moment [N m] about the CoM (at c_z) of ``force`` acting at ground ``point``."""
+    arm = np.array([point[0] - com[0], point[1] - com[1], -MODEL.com_height])
+    return np.cross(arm, force)[:2]
+
+
+def test_the_planners_zmp_and_hdot_give_the_pivot_where_the_force_line_meets_the_ground():
+    """r = p - H hdot / (m g): the net force m omega^2 (c - r), m g passes through the
+    CoM and r, and applied at the ZMP p it turns the body at hdot (the CMP, Popovic,
+    Goswami and Herr 2005)."""
+    for com, zmp, rate in cases():
+        r = pivot(zmp, rate, MODEL.mass)
+        force = contact_force(MODEL, com, r)
+        np.testing.assert_allclose(moment_about_com(r, com, force), 0.0, atol=1e-9)
+        np.testing.assert_allclose(moment_about_com(zmp, com, force), rate, atol=1e-9)
+
+
+def test_without_angular_momentum_rate_the_cop_is_the_pivot():
+    for _, zmp, _ in cases(10):
+        r = pivot(zmp, np.zeros(2), MODEL.mass)
+        np.testing.assert_array_equal(r, zmp)
+        for double_support in (True, False):
+            cop = centre_of_pressure(r, np.zeros(2), MODEL.mass, zmp, SOLE, double_support)
+            np.testing.assert_allclose(cop, r, atol=1e-12)
+
+
+def test_the_cop_moves_by_h_ldot_over_m_g_so_the_ground_turns_the_body_at_its_ldot():
+    """cop = r + H Ldot / (m g): the ground force at the CoP accelerates the CoM as the
+    pivot says and changes the body's angular momentum at the motion's Ldot."""
+    for com, zmp, rate in cases():
+        r = pivot(zmp, rate, MODEL.mass)
+        motion_rate = -rate[::-1]  # any Ldot
+        cop = centre_of_pressure(r, motion_rate, MODEL.mass, np.zeros(2), SOLE, True)
+        force = contact_force(MODEL, com, r)
+        np.testing.assert_allclose(moment_about_com(cop, com, force), motion_rate, atol=1e-9)
+        shift = np.linalg.norm(cop - r)
+        assert shift == pytest.approx(np.linalg.norm(motion_rate) / (MODEL.mass * GRAVITY))
+
+
+def test_the_net_force_is_the_lipms():
+    """m cdd = m omega^2 (c - r) horizontally and m g vertically."""
+    for com, zmp, rate in cases():
+        r = pivot(zmp, rate, MODEL.mass)
+        force = contact_force(MODEL, com, r)
+        np.testing.assert_allclose(force[:2] / MODEL.mass, MODEL.omega**2 * (com - r))
+        assert force[2] == pytest.approx(MODEL.mass * GRAVITY)
+
+
+def test_in_single_support_the_cop_is_clipped_to_the_stance_sole():
+    """The nearest point of the sole rectangle around the stance foothold; inside, the
+    CoP is kept; in double support it is not clipped (the wrench distribution keeps
+    it in the support)."""
+    stance = np.array([0.3, -0.1])
+    low = stance + np.array([SOLE.x_min, -SOLE.half_width])
+    high = stance + np.array([SOLE.x_max, SOLE.half_width])
+    rng = np.random.default_rng(RNG_SEED)
+    # The sole as a grid of points 0.5 mm apart, for a brute-force nearest point.
+    xs = np.linspace(low[0], high[0], 341)
+    ys = np.linspace(low[1], high[1], 101)
+    grid = np.stack(np.meshgrid(xs, ys), axis=-1).reshape(-1, 2)
+    clipped = 0
+    for wanted in rng.uniform(-0.3, 0.3, (200, 2)) + stance:
+        cop = centre_of_pressure(wanted, np.zeros(2), MODEL.mass, stance, SOLE, False)
+        assert np.all(cop >= low - 1e-12) and np.all(cop <= high + 1e-12)
+        nearest = grid[np.argmin(np.linalg.norm(grid - wanted, axis=1))]
+        assert np.linalg.norm(cop - wanted) <= np.linalg.norm(nearest - wanted) + 1e-12
+        if np.any(wanted < low) or np.any(wanted > high):
+            clipped += 1
+        else:
+            np.testing.assert_array_equal(cop, wanted)
+        double = centre_of_pressure(wanted, np.zeros(2), MODEL.mass, stance, SOLE, True)
+        np.testing.assert_array_equal(double, wanted)
+    assert clipped > 100

@@ -1,0 +1,144 @@
+"""The whole-body controller's tick (:mod:`app.stabilizer.controller`) on measurement
+records made by hand: it needs no simulator, and what it commands holds the robot."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from app.lowlevel import FootForce, JointCommand, RobotMeasurement
+from app.stabilizer.config import StabilizerConfig
+from app.stabilizer.controller import WholeBodyController
+from conftest import LEFT, RIGHT, command
+from kinematics.robot_model import RobotModel
+from kinematics.swing_foot import SwingTiming
+from kinematics.whole_body_ik import sole_pose
+from planner.parameters import GRAVITY
+from robots import get_robot
+
+G1 = get_robot("g1")
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(autouse=True)
+def _cache_in_tmp(tmp_path_factory, monkeypatch):
+    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+
+
+def standing(estimator: str = "truth") -> tuple[WholeBodyController, RobotMeasurement]:
+    """A controller reset on G1's two feet, and the measurement of the robot standing
+    still where the IK put it, each foot carrying half the weight under its ankle."""
+    controller = WholeBodyController(G1, SwingTiming(), 0.01, StabilizerConfig(estimator=estimator))
+    soles = {
+        "left": sole_pose(np.array([*LEFT.position, 0.0])),
+        "right": sole_pose(np.array([*RIGHT.position, 0.0])),
+    }
+    angles = controller.reset(soles, "left", np.zeros(2))
+    base = np.asarray(controller.ik.robot.get_T_world_fbase(), float)
+    half = controller.mass * GRAVITY / 2
+    measurement = RobotMeasurement(
+        time=0.0,
+        joint_positions=angles,
+        joint_velocities=np.zeros(len(angles)),
+        base_orientation=Rotation.from_matrix(base[:3, :3]).as_quat(),
+        base_angular_velocity=np.zeros(3),
+        foot_forces={
+            "left": FootForce(half, LEFT.position),
+            "right": FootForce(half, RIGHT.position),
+        },
+        base_position=base[:3, 3].copy(),
+        base_linear_velocity=np.zeros(3),
+    )
+    return controller, measurement
+
+
+def test_a_tick_on_a_hand_made_measurement_holds_the_robot_up():
+    """Standing, CoM over the middle of the feet: the command has one entry per joint,
+    the contact forces the feed-forward is computed for carry m g, and with them the
+    floating base is in equilibrium (the base rows of the dynamics balance)."""
+    controller, measurement = standing()
+    order = controller.tick(measurement, command(0.0, np.zeros(2)))
+    count = len(controller.model.joint_names)
+    assert isinstance(order, JointCommand)
+    for field in dataclasses.fields(order):
+        value = getattr(order, field.name)
+        assert value.shape == (count,) and np.all(np.isfinite(value)), field.name
+    np.testing.assert_allclose(order.position, measurement.joint_positions, atol=1e-3)
+    assert np.all(order.stiffness > 0.0) and np.all(order.damping > 0.0)
+
+    contact = controller.expected_contact_force
+    rotation = Rotation.from_quat(measurement.base_orientation).as_matrix()
+    force_in_world = rotation @ contact[:3]  # the base's linear rows: the net force
+    assert force_in_world[2] == pytest.approx(controller.mass * GRAVITY, rel=1e-6)
+    np.testing.assert_allclose(force_in_world[:2], 0.0, atol=1e-3 * controller.mass * GRAVITY)
+    # Newton-Euler of the floating base at rest: gravity's base rows = the contacts'.
+    model = RobotModel(G1)
+    q = np.concatenate(
+        [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
+    )
+    model.update(q, np.zeros(model.nv))
+    gravity = model.inverse_dynamics(np.zeros(model.nv))
+    np.testing.assert_allclose(contact[:3], gravity[:3], atol=0.01 * controller.mass * GRAVITY)
+    np.testing.assert_allclose(contact[3:6], gravity[3:6], atol=0.5)  # [N m]
+    # The legs carry the weight symmetrically: each knee's torque is the other's.
+    knees = controller.model.index_of(["left_knee_joint", "right_knee_joint"])
+    assert abs(order.torque[knees[0]]) > 5.0
+    assert order.torque[knees[0]] == pytest.approx(order.torque[knees[1]], rel=0.05)
+
+
+def test_with_leg_odometry_the_tick_ignores_the_simulators_truth():
+    """In ``odometry`` mode the base comes from the stance foot, the encoders and the
+    IMU: a measurement whose truth fields (base position and velocity) are wrong
+    gives the same command; in ``truth`` mode it does not."""
+    for estimator, same in (("odometry", True), ("truth", False)):
+        commands = []
+        for corrupt in (False, True):
+            controller, measurement = standing(estimator)
+            controller.tick(measurement, command(0.0, np.zeros(2)))
+            later = dataclasses.replace(measurement, time=0.01)
+            if corrupt:
+                later = dataclasses.replace(
+                    later,
+                    base_position=later.base_position + np.array([0.05, -0.03, 0.02]),
+                    base_linear_velocity=np.array([0.3, 0.2, -0.1]),
+                )
+            commands.append(controller.tick(later, command(0.01, np.zeros(2))))
+        unchanged = np.allclose(commands[0].position, commands[1].position, atol=1e-9)
+        unchanged &= np.allclose(commands[0].torque, commands[1].torque, atol=1e-6)
+        assert unchanged == same, estimator
+
+
+TICK_WITHOUT_PYBULLET = """
+import sys
+for name in ("pybullet", "pybullet_data", "pybullet_utils", "pybullet_utils.bullet_client"):
+    sys.modules[name] = None  # any import of PyBullet fails
+sys.path.insert(0, "tests")
+from test_controller import standing
+from conftest import command
+import numpy as np
+controller, measurement = standing()
+order = controller.tick(measurement, command(0.0, np.zeros(2)))
+print(len(order.torque), float(controller.expected_contact_force[2]))
+"""
+
+
+def test_the_controller_runs_without_pybullet():
+    """The controller's modules import nothing of PyBullet: the tick runs in a process
+    where importing PyBullet fails."""
+    result = subprocess.run(
+        [sys.executable, "-c", TICK_WITHOUT_PYBULLET],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert result.returncode == 0, result.stderr[-2000:]
+    joints, vertical = result.stdout.split()[-2:]
+    assert int(joints) == 29 - len(G1.locked_joints)
+    assert float(vertical) > 0.0
