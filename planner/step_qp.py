@@ -55,6 +55,7 @@ import qpsolvers
 
 from .exceptions import StepQpError
 from .parameters import Constraints, RsgParameters
+from .qp import solve_polished
 
 
 @dataclass(frozen=True)
@@ -227,15 +228,10 @@ def solve_with_qpsolvers(problem: StepQpProblem, solver: str = "proxqp") -> np.n
     p = 2.0 * problem.lyapunov_matrix
     q = -2.0 * problem.lyapunov_matrix @ problem.target
     try:
-        x = qpsolvers.solve_qp(
-            p,
-            q,
-            lb=lower,
-            ub=upper,
-            solver=solver,
-            eps_abs=1e-9,
-            eps_rel=0.0,
-        )
+        if solver == "proxqp":
+            x = solve_polished(p, q, lb=lower, ub=upper, eps_abs=1e-9)
+        else:
+            x = qpsolvers.solve_qp(p, q, lb=lower, ub=upper, solver=solver, eps_abs=1e-9)
     except (qpsolvers.SolverError, ValueError) as exc:
         raise StepQpError(f"qpsolvers/{solver} failed: {exc}", problem) from exc
     return None if x is None else np.asarray(x, dtype=float)

@@ -183,9 +183,7 @@ def test_sweep_and_run_accept_it_on_pybullet_only(tmp_path: Path, capsys) -> Non
 
 @pytest.mark.slow
 def test_placo_wpg_walks_the_g1_for_10_s_deterministically() -> None:
-    """No push: 10 s on G1 without a fall, nominal steps, twice the same (the same step
-    times, the CoM within 5 mm: runs are not bit-exact under torque control,
-    docs/full-robot.md; 1.7 mm apart measured)."""
+    """No push: 10 s on G1 without a fall, nominal steps, twice the same bit for bit."""
     from app.placo_wpg import build_placo_wpg_backend
     from app.runner import run_closed_loop
     from app.scenarios import Scenario
@@ -206,7 +204,7 @@ def test_placo_wpg_walks_the_g1_for_10_s_deterministically() -> None:
             backend.close()
     first, second = results
     for name in ("com_x", "com_y"):
-        np.testing.assert_allclose(first.column(name), second.column(name), rtol=0, atol=5e-3)
+        np.testing.assert_array_equal(first.column(name), second.column(name))
     assert [s.event["t"] for s in first.steps] == [s.event["t"] for s in second.steps]
     assert not first.fall.fell, first.fall.reason
     assert first.sim_time == pytest.approx(10.0)

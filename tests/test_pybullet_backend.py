@@ -253,18 +253,16 @@ def pushed_runs(tmp_path_factory):
 
 
 def test_same_commands_give_the_same_result(pushed_runs):
-    """Within 0.1 mm and 0.1 mm/s: runs are not bit-exact under torque control (1e-14
-    apart at first, 4e-5 after 1 s; docs/notes/2026-12-02-torque-control.md)."""
+    """Bit for bit (the QPs' answers are polished: planner/qp.py)."""
     first, second, _ = pushed_runs
     assert np.linalg.norm(first[0][3:5]) > 0.01  # the push moved the robot
-    np.testing.assert_allclose(first[0], second[0], atol=1e-4)
+    np.testing.assert_array_equal(first[0], second[0])
 
 
 def test_the_physics_log_observes_without_changing_the_run(pushed_runs):
-    """A run with the log ends in the state of the same run without it (as close as two
-    runs without it)."""
+    """A run with the log ends in the state of the same run without it, bit for bit."""
     plain, _, logged = pushed_runs
-    np.testing.assert_allclose(plain[0], logged[0], atol=1e-4)
+    np.testing.assert_array_equal(plain[0], logged[0])
 
 
 def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):

@@ -68,13 +68,12 @@ def run_g1(
 
 
 def test_two_identical_runs_give_the_same_results():
-    """The same steps, CoM within 1 mm and landing errors within 1 mm (not bit-exact
-    under torque control: docs/full-robot.md)."""
+    """Bit for bit: every QP answer is polished to its exact optimum (planner/qp.py)."""
     first, first_errors = run_g1(BUILT_IN["walk"], duration=1.5)
     second, second_errors = run_g1(BUILT_IN["walk"], duration=1.5)
-    for name in ("com_x", "com_y"):
-        np.testing.assert_allclose(first.column(name), second.column(name), rtol=0, atol=1e-3)
-    np.testing.assert_allclose(first_errors, second_errors, rtol=0.0, atol=1e-3)
+    for name in ("com_x", "com_y", "zmp_x", "zmp_y", "lyapunov"):
+        np.testing.assert_array_equal(first.column(name), second.column(name))
+    np.testing.assert_array_equal(first_errors, second_errors)
     assert [s.event for s in first.steps] == [s.event for s in second.steps]
 
 

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from qpsolvers import solve_qp
 
 from planner.exceptions import RsgError
+from planner.qp import solve_polished
 from robots.description import SoleRectangle
 
 # The QP is solved for wrenches divided by the desired normal force (well conditioned);
@@ -171,15 +171,7 @@ def distribute_wrench(
         G[row : row + len(h_foot), 6 * index : 6 * index + 6] = G_foot
         row += len(h_foot)
     for regularisation, eps_abs in ATTEMPTS:
-        solution = solve_qp(
-            P + regularisation * np.eye(size),
-            q,
-            G,
-            h,
-            solver="proxqp",
-            eps_abs=eps_abs,
-            eps_rel=0.0,
-        )
+        solution = solve_polished(P + regularisation * np.eye(size), q, G, h, eps_abs=eps_abs)
         if solution is not None:
             break
     if solution is None:
