@@ -16,17 +16,16 @@ import signal
 import threading
 import time as wallclock
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
 import numpy as np
 
+from app.backends.base import Backend, FallStatus, InitialCondition
+from app.scenarios import Scenario
 from planner.parameters import PlannerConfig
 from planner.step_generator import ReactiveStepGenerator
 from planner.types import Foothold, MeasuredState, PlannerOutput, Push, sigma_of
-
-from .backend import Backend, FallStatus, InitialCondition
-from .scenarios import Scenario
 
 TOLERANCE = 1e-6  # [m] or [N m]: numerical slack of the constraint checks
 
@@ -47,7 +46,7 @@ class StepPlanner(Protocol):
 
     ``design`` has ``threshold`` (gamma_v), ``matrix`` and ``gain`` (written to
     the results); :class:`planner.step_generator.ReactiveStepGenerator` is one,
-    the placo-wpg baseline (:mod:`app.placo_wpg`) another.
+    the placo-wpg baseline (:mod:`app.baselines.placo_wpg`) another.
     """
 
     design: Any
@@ -251,6 +250,12 @@ class ClosedLoop:
         """Apply ``push`` too (its time is absolute [s])."""
         self.scenario = self.scenario.with_pushes([push])
 
+    def push_now(self, push: Push) -> None:
+        """Apply ``push`` and forget the pushes that are over: a loop without end (the
+        live demo) keeps its list short."""
+        ongoing = tuple(p for p in self.scenario.pushes if p.time + p.duration > self.time)
+        self.scenario = replace(self.scenario, pushes=ongoing).with_pushes([push])
+
     def tick(self) -> PlannerOutput:
         """Run one control tick; returns the planner's output for it."""
         start = wallclock.perf_counter()
@@ -339,7 +344,7 @@ def run_closed_loop(
             and returns what was simulated, marked ``interrupted``; a second Ctrl-C
             raises KeyboardInterrupt at once. Only in the main thread.
         on_tick: Called after every tick with the loop and the tick's output (e.g. a
-            :class:`app.replay.ReplayRecorder`).
+            :class:`app.results.replay.ReplayRecorder`).
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.

@@ -43,11 +43,10 @@ from typing import Any
 
 import numpy as np
 
+from app.setup.overrides import parse_decimal
 from planner.exceptions import ParameterError
 from planner.parameters import LipmModel, Range
 from planner.types import Push
-
-from .overrides import parse_decimal
 
 PAPER_MASS = LipmModel().mass  # [kg] mass the paper's impulses are taken for
 MAX_IMPULSE = 500.0  # [N s] sanity bound on one push (8 m/s on the paper's 60 kg)

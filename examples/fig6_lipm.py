@@ -6,7 +6,7 @@ Lyapunov level V_u of the DCM error falls back below gamma_v. Run: python exampl
 
 import numpy as np
 
-from app.lipm_backend import LipmBackend
+from app.backends.lipm import LipmBackend
 from app.runner import walking_start
 from app.scenarios import BUILT_IN
 from planner import MeasuredState, PlannerConfig, ReactiveStepGenerator

@@ -6,9 +6,9 @@ next step. Takes about 10 s. Run: python examples/push_g1.py
 
 import numpy as np
 
-from app.robot_setup import build_robot_backend
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
+from app.setup.build import build_robot_backend
 from planner import Push
 
 backend, config, initial = build_robot_backend("g1", "rsg")  # torque-controlled G1

@@ -8,8 +8,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from app.envelope import build_envelope, format_table
-from app.sweep import SweepSpec, run_sweep
+from app.experiments.envelope import build_envelope, format_table
+from app.experiments.sweep import SweepSpec, run_sweep
 
 spec = SweepSpec(model="lipm", controllers=("rsg", "no-step"), directions=4, phases=(0.5,))
 out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(tempfile.mkdtemp(prefix="rsg-sweep-"))

@@ -12,8 +12,16 @@ from robots.g1 import G1
 from robots.talos import TALOS
 
 _REGISTRY: dict[str, RobotDescription] = {robot.name: robot for robot in (G1, TALOS)}
+DEFAULT_ROBOT = "g1"  # the robot a full-robot run uses when none is named
 
-__all__ = ["JointImpedance", "RobotDescription", "SoleRectangle", "available_robots", "get_robot"]
+__all__ = [
+    "DEFAULT_ROBOT",
+    "JointImpedance",
+    "RobotDescription",
+    "SoleRectangle",
+    "available_robots",
+    "get_robot",
+]
 
 
 def available_robots() -> list[str]:

@@ -17,7 +17,7 @@ from typing import Any
 from planner.exceptions import ParameterError
 from planner.parameters import CORNER_RANGE, RANGES
 
-#: Fields handed to the planner (app.robot_setup.planner_config_for), checked with the
+#: Fields handed to the planner (app.setup.robot_config.planner_config_for), checked with the
 #: planner's ranges so that an error names the description field.
 PLANNER_FIELDS = (
     "stride_length",

@@ -22,7 +22,7 @@ under position control, kept since):
 * ``dcm_inset`` 0.02 m and |hdot| <= 5 N m: the planner's row (27c') and the bound
   on its feedback angular momentum rate.
 * ``physics_time_step`` 2 ms with 75 solver iterations: the motors' stable PD law
-  (``app/joint_motors.py``) is stable at this step; 1 ms doubles the physics' cost.
+  (``app/backends/joint_motors.py``) is stable at this step; 1 ms doubles the physics' cost.
 * ``locked_joints``: the ten distal arm joints are welded at their standing angles
   (the flywheel uses the waist and the shoulders' pitch and roll): 19 actuated
   joints, a physics step 0.58 times as long.

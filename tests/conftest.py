@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from numpy.typing import NDArray
 
-from app.lipm_backend import LipmBackend
+from app.backends.lipm import LipmBackend
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, Scenario
 from planner.parameters import GRAVITY, PlannerConfig

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from app.bench import bench_rsg_ticks, bench_step_qp, format_bench, stats, timed
 from app.cli import main
+from app.experiments.bench import bench_rsg_ticks, bench_step_qp, format_bench, stats, timed
 
 
 def test_stats_and_wrapper() -> None:
@@ -49,7 +49,7 @@ def test_bench_times_the_robot_it_is_given_with_set(
     with all 29 joints in the physics at 1 kHz; the default has the description's
     locked joints welded (fewer motors) at 500 Hz, and the table says which step;
     a bad value is an error naming the field before anything runs."""
-    from app.bench import bench_robot
+    from app.experiments.bench import bench_robot
 
     counts, steps, labels = [], [], []
     for overrides in ((), (("locked_joints", "none"), ("physics_time_step", "0.001"))):
@@ -68,7 +68,7 @@ def test_bench_times_the_robot_it_is_given_with_set(
 
 def test_tick_breakdown_adds_up_the_parts() -> None:
     """The controller's time less the IK's is the stabilizer's; the parts add up."""
-    from app.bench import tick_breakdown
+    from app.experiments.bench import tick_breakdown
 
     report = {
         "control_period": 0.01,

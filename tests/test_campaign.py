@@ -11,8 +11,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import app.campaign as campaign_module
-from app.campaign import (
+import app.experiments.campaign as campaign_module
+from app.cli import main
+from app.experiments.campaign import (
     REFERENCE_MASS,
     SEEDS,
     CampaignJob,
@@ -25,9 +26,8 @@ from app.campaign import (
     run_campaign_job,
     touchdowns,
 )
-from app.campaign_report import push_argument, push_rows, summarize
-from app.cli import main
-from app.push_outcome import PushRun
+from app.experiments.campaign_report import push_argument, push_rows, summarize
+from app.experiments.outcome import PushRun
 from planner.exceptions import ParameterError
 from robots import get_robot
 

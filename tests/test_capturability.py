@@ -10,15 +10,10 @@ from functools import cache
 import numpy as np
 import pytest
 
-from app.capturability import (
-    CaptureModel,
-    capture_distance,
-    capture_edges,
-    impulse_bound,
-    nominal_state,
-)
-from app.capture_lp import PushCase, largest_impulse
-from app.lipm_backend import LEG_REACH
+from app.backends.lipm import LEG_REACH
+from app.experiments.capturability import CaptureModel, capture_distance, capture_edges
+from app.experiments.capture_bound import impulse_bound, nominal_state
+from app.experiments.capture_lp import PushCase, largest_impulse
 from planner.exceptions import ParameterError
 from planner.hybrid_lipm import dcm, integrate_lipm
 from planner.parameters import PlannerConfig

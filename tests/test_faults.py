@@ -1,7 +1,7 @@
 """Faults seen from outside the process: signals, killed sweeps, real exit codes.
 
 - SIGKILL of ``rsg sweep``: its worker processes end within a few seconds
-  (``app.sweep._die_with_parent``), and the same command run again resumes with the
+  (``app.experiments.jobs._die_with_parent``), and the same command run again resumes with the
   finished jobs kept.
 - Ctrl-C (SIGINT) during ``rsg run``: what was simulated is written, marked
   interrupted, exit code 130.

@@ -21,9 +21,9 @@ from pathlib import Path
 import pytest
 
 from app.cli import main
-from app.overrides import backend_option_types, rsg_parameter_types
-from app.result_folder import RESULT_FILES
-from app.sweep import SPEC_FILE, Job, SweepSpec
+from app.experiments.sweep import SPEC_FILE, Job, SweepSpec
+from app.results.folder import RESULT_FILES
+from app.setup.overrides import backend_option_types, rsg_parameter_types
 
 pytestmark = pytest.mark.filterwarnings("error::RuntimeWarning")
 

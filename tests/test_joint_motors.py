@@ -1,4 +1,4 @@
-"""The simulated joint motors (:mod:`app.joint_motors`): G1's PD law with feed-forward,
+"""The simulated joint motors (:mod:`app.backends.joint_motors`): G1's PD law with feed-forward,
 in the stable-PD form, within the effort limits."""
 
 from __future__ import annotations
@@ -9,10 +9,10 @@ import numpy as np
 import pybullet
 import pytest
 
-from app.backend import InitialCondition
+from app.backends.base import InitialCondition
+from app.backends.pybullet import PyBulletBackend
+from app.backends.pybullet_robot import SimulatedRobot
 from app.lowlevel import JointCommand
-from app.pybullet_backend import PyBulletBackend
-from app.pybullet_robot import SimulatedRobot
 from app.stabilizer.controller import joint_impedance
 from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from robots import get_robot

@@ -9,10 +9,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.physics_log import COLUMNS, PhysicsLog
-from app.robot_setup import build_robot_backend
+from app.backends.physics_log import COLUMNS, PhysicsLog
 from app.runner import ClosedLoop
 from app.scenarios import BUILT_IN
+from app.setup.build import build_robot_backend
 from app.stabilizer.landing import WINDOW, Landing
 from planner.parameters import GRAVITY
 

@@ -6,9 +6,9 @@ import json
 from pathlib import Path
 
 from app.cli import main
-from app.monotonicity import FRACTIONS, run_monotonicity
-from app.sweep import SweepSpec
-from app.sweep_trial import push_timing
+from app.experiments.monotonicity import FRACTIONS, run_monotonicity
+from app.experiments.sweep import SweepSpec
+from app.experiments.trial import push_timing
 from planner.parameters import PlannerConfig
 
 

@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 
 from app.cli import main
-from app.overrides import allowed_names, parse_assignment, parse_overrides, parse_value
-from app.push_grid import GridSpec, run_grid
-from app.robot_setup import build_robot_backend, robot_with_overrides
+from app.commands.arguments import parse_assignment
+from app.experiments.grid import GridSpec, run_grid
+from app.experiments.sweep import SweepSpec, run_sweep
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.setup import build_backend
+from app.setup.build import build_backend, build_robot_backend, robot_with_overrides
+from app.setup.overrides import allowed_names, parse_overrides, parse_value
 from app.stabilizer.config import OPTION_NAMES
-from app.sweep import SweepSpec, run_sweep
 from planner.exceptions import ParameterError
 from planner.types import Push
 from robots import get_robot
@@ -291,7 +291,7 @@ def test_the_reanchor_time_of_a_robot_reaches_its_planner() -> None:
 def test_the_solver_iterations_reach_pybullet() -> None:
     """``--set solver_iterations=N`` sets PyBullet's contact and motor solver; a value
     out of range names the field before any run."""
-    from app.pybullet_robot import SimulatedRobot
+    from app.backends.pybullet_robot import SimulatedRobot
 
     description, _ = robot_with_overrides("g1", (("solver_iterations", "30"),), "pybullet")
     robot = SimulatedRobot(description)
@@ -309,9 +309,9 @@ def test_the_solver_iterations_reach_pybullet() -> None:
 def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
     """``--set physics_time_step=0.001`` runs G1's physics at 1 kHz instead of 500 Hz:
     PyBullet's fixed step, the simulated time per step and the motors' stable PD
-    step (:mod:`app.joint_motors`) follow. A step that does not divide the control
+    step (:mod:`app.backends.joint_motors`) follow. A step that does not divide the control
     period is an error naming it before any run."""
-    from app.pybullet_robot import SimulatedRobot
+    from app.backends.pybullet_robot import SimulatedRobot
 
     g1 = get_robot("g1")
     for text, step in (("0.001", 0.001), (None, g1.physics_time_step)):
@@ -359,7 +359,7 @@ def test_locked_joints_are_welded_in_pybullet_and_set_unlocks_them() -> None:
     """G1's locked arm joints are not PyBullet joints (no motor, no degree of freedom);
     ``--set locked_joints=none`` actuates all 29, and a name that is not a joint of the
     URDF is an error naming the field."""
-    from app.pybullet_robot import SimulatedRobot
+    from app.backends.pybullet_robot import SimulatedRobot
 
     g1 = get_robot("g1")
     for overrides, count in (((), 29 - len(g1.locked_joints)), ((("locked_joints", "none"),), 29)):

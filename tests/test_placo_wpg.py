@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from app.baselines.placo_wpg import CROSSING_DELAY, PlacoWalkPlanner, humanoid_parameters
 from app.cli import main
-from app.placo_wpg import CROSSING_DELAY, PlacoWalkPlanner, humanoid_parameters
-from app.robot_setup import planner_config_for
+from app.experiments.sweep import SweepSpec
 from app.runner import walking_start
-from app.sweep import SweepSpec
+from app.setup.robot_config import planner_config_for
 from planner.types import MeasuredState, PlannerOutput, sigma_of
 from robots import get_robot
 
@@ -184,7 +184,7 @@ def test_sweep_and_run_accept_it_on_pybullet_only(tmp_path: Path, capsys) -> Non
 @pytest.mark.slow
 def test_placo_wpg_walks_the_g1_for_10_s_deterministically() -> None:
     """No push: 10 s on G1 without a fall, nominal steps, twice the same bit for bit."""
-    from app.placo_wpg import build_placo_wpg_backend
+    from app.baselines.placo_wpg import build_placo_wpg_backend
     from app.runner import run_closed_loop
     from app.scenarios import Scenario
 

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 from app.cli import main
-from app.protocol import DIRECTIONS, GRAVITY, ProtocolSpec, protocol_jobs
-from app.push_outcome import PushRun, impulse_along
+from app.experiments.outcome import PushRun, impulse_along
+from app.experiments.protocol import DIRECTIONS, GRAVITY, ProtocolSpec, protocol_jobs
+from app.experiments.sweep import run_job
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.setup import build_backend
-from app.sweep import run_job
+from app.setup.build import build_backend
 from planner.exceptions import ParameterError
 from planner.types import Push
 

@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from app.cli import main
-from app.push_grid import GridSpec, format_grid, run_grid, summarize, write_grid
+from app.experiments.grid import GridSpec, format_grid, run_grid, summarize, write_grid
 from planner.exceptions import ParameterError
 
 

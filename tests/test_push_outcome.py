@@ -5,8 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.push_grid import GridSpec
-from app.push_outcome import PushRun, adjusted_steps_after, describe, outcome_of, settle_steps
+from app.experiments.grid import GridSpec
+from app.experiments.outcome import (
+    PushRun,
+    adjusted_steps_after,
+    describe,
+    outcome_of,
+    settle_steps,
+)
 from app.runner import RunResult
 from planner.types import Push
 

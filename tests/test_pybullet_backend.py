@@ -8,8 +8,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.backend import InitialCondition
-from app.pybullet_backend import PyBulletBackend
+from app.backends.base import InitialCondition
+from app.backends.pybullet import PyBulletBackend
 from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from planner.exceptions import ParameterError
 from planner.parameters import GRAVITY
@@ -227,7 +227,7 @@ def test_backend_options_are_checked_before_the_robot_is_loaded(options, field):
 def pushed_run(logged: bool):
     """1 s of standing with 60 N forward and 30 N sideways from 0.3 to 0.4 s, on a new
     backend; returns the final CoM state and the physics log (or None)."""
-    from app.physics_log import PhysicsLog
+    from app.backends.physics_log import PhysicsLog
 
     instance = PyBulletBackend("g1")
     try:
@@ -269,7 +269,7 @@ def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):
     """One row per physics step (2 ms on G1); before the push the feet carry the weight
     on average (vertical equilibrium); the CoM velocity is the derivative of the CoM;
     the push is logged while it acts and its impulse is the one applied."""
-    from app.physics_log import COLUMNS
+    from app.backends.physics_log import COLUMNS
 
     _, log, mass, step = pushed_runs[2]
     path = log.write(tmp_path / "physics.csv")

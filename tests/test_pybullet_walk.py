@@ -1,7 +1,7 @@
 """The RSG walking the Unitree G1 in PyBullet (slow: full-robot runs).
 
 The walk, push and paper-fig6 tests state the goals of the full-robot backend (the
-torque-controlled robot of :mod:`app.pybullet_robot` under the whole-body
+torque-controlled robot of :mod:`app.backends.pybullet_robot` under the whole-body
 stabilizer of :mod:`app.stabilizer`); the figures in the docstrings were measured
 with the defaults of ``robots/g1.py`` and ``app/stabilizer/config.py``, where given.
 See also ``rsg run --physics-log``.
@@ -14,10 +14,10 @@ import dataclasses
 import numpy as np
 import pytest
 
-from app.push_grid import GridSpec, run_grid
-from app.robot_setup import build_robot_backend
+from app.experiments.grid import GridSpec, run_grid
 from app.runner import ClosedLoop, RunResult
 from app.scenarios import BUILT_IN, Scenario
+from app.setup.build import build_robot_backend
 from planner.types import Push
 
 pytestmark = pytest.mark.slow

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.lipm_backend import LipmBackend
-from app.replay import REPLAY_FILE, ReplayError, ReplayRecorder, load_replay
+from app.backends.lipm import LipmBackend
+from app.results.replay import REPLAY_FILE, ReplayError, ReplayRecorder, load_replay
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import Scenario
 from planner.lyapunov import design_lyapunov

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from app.push_grid import GridSpec, run_grid
-from app.replay import load_replay
-from app.replay_keep import (
+from app.experiments.grid import GridSpec, run_grid
+from app.results.replay import load_replay
+from app.results.worst_runs import (
     format_replays,
     replay_name,
     worst_grid_runs,

@@ -49,7 +49,7 @@ def test_sole_spinning_friction_is_validated(value):
 @pytest.mark.parametrize("value", [0.0, 0.01])
 def test_soles_get_their_torsional_friction_in_pybullet(value):
     """The soles' spinning friction reaches PyBullet; the other links keep none."""
-    from app.pybullet_robot import SimulatedRobot
+    from app.backends.pybullet_robot import SimulatedRobot
 
     robot = SimulatedRobot(dataclasses.replace(get_robot("g1"), sole_spinning_friction=value))
     try:
@@ -254,7 +254,7 @@ def test_talos_derived_urdf_has_sole_frames_under_the_ankles_and_resolved_meshes
 
 
 def test_talos_mass_in_pybullet_and_placo_equals_the_urdf_mass():
-    from app.pybullet_robot import SimulatedRobot
+    from app.backends.pybullet_robot import SimulatedRobot
     from kinematics.whole_body_ik import WholeBodyIK
 
     talos = get_robot("talos")

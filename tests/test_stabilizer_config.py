@@ -7,7 +7,7 @@ import dataclasses
 
 import pytest
 
-from app.pybullet_backend import stabilizer_config
+from app.backends.pybullet import stabilizer_config
 from app.stabilizer.config import OPTION_NAMES, RANGES, StabilizerConfig
 from app.stabilizer.controller import joint_impedance
 from kinematics.robot_model import RobotModel

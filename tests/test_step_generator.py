@@ -7,7 +7,7 @@ import pytest
 
 from app.runner import walking_start
 from app.scenarios import BUILT_IN, Scenario
-from app.setup import paper_rules
+from app.setup.paper_rules import paper_rules
 from conftest import run_lipm, scaled
 from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import PlannerConfig
@@ -69,7 +69,7 @@ def test_post_step_level_decreases_in_case_a(scenario):
     the post-step level by at least gamma_v. Pushes away from the stance side, where
     (27b) does not block the step (25) asks for; the forward push needs two adjusted
     steps, the first leaving V_u above gamma_v."""
-    from app.lipm_backend import LipmBackend
+    from app.backends.lipm import LipmBackend
     from app.runner import run_closed_loop
 
     config = PlannerConfig()
@@ -311,9 +311,9 @@ def test_paper_rules_give_the_papers_jump_set_on_fig6():
     """--paper-rules: no push hold, no leg reach; paper-fig6 is recovered with the
     adjusted step while push 1 still acts (V_u reaches gamma_v), the default steps at
     its end."""
-    from app.lipm_backend import LipmBackend
+    from app.backends.lipm import LipmBackend
     from app.runner import run_closed_loop
-    from app.setup import build_backend
+    from app.setup.build import build_backend
 
     _, config, _ = build_backend("lipm", None, "rsg", paper=True)
     assert config.rsg.push_hold_time == 0.0 and config.constraints.com_reach == np.inf
@@ -377,7 +377,7 @@ def test_a_timing_jump_never_postpones_the_nominal_step():
 
 def test_step_reaction_time_recovers_what_the_instant_step_recovers():
     """On the LIPM a 0.1 s reaction time still recovers paper-fig6 scaled x2."""
-    from app.lipm_backend import LipmBackend
+    from app.backends.lipm import LipmBackend
     from app.runner import run_closed_loop
 
     config = _reaction_config(0.1)

@@ -10,14 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import app.sweep as sweep_module
-from app.bisection import bisect_threshold
-from app.envelope import build_envelope, format_table, write_envelope
+import app.experiments.sweep as sweep_module
+from app.experiments.bisection import bisect_threshold
+from app.experiments.envelope import build_envelope, format_table, write_envelope
+from app.experiments.plots import plot_envelope
+from app.experiments.sweep import Job, SweepSpec, _build, run_sweep
+from app.experiments.trial import SettledTrial, push_timing
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.sweep import Job, SweepSpec, _build, run_sweep
-from app.sweep_plot import plot_envelope
-from app.sweep_trial import SettledTrial, push_timing
 from planner.exceptions import ParameterError
 from planner.parameters import PlannerConfig
 from planner.types import Push

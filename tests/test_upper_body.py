@@ -8,8 +8,8 @@ import numpy as np
 import pinocchio
 import pytest
 
-from app.backend import InitialCondition
-from app.pybullet_backend import PyBulletBackend
+from app.backends.base import InitialCondition
+from app.backends.pybullet import PyBulletBackend
 from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import argparse
 
-from app.overrides import add_robot_argument
+from app.commands.arguments import add_robot_argument
 from planner.parameters import CONTROLLERS
 
 DEMO_EPILOG = """\

@@ -19,8 +19,7 @@ from .serve import check_address, serve
 def _robot_urdf(model: str, robot: str | None) -> Path | None:
     if model != "pybullet":
         return None
-    from app.setup import DEFAULT_ROBOT
-    from robots import get_robot
+    from robots import DEFAULT_ROBOT, get_robot
     from robots.urdf_cache import derived_urdf
 
     return derived_urdf(get_robot(robot or DEFAULT_ROBOT))

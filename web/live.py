@@ -17,14 +17,13 @@ import sys
 import threading
 import time as wallclock
 from collections.abc import Callable
-from dataclasses import replace
 
 import numpy as np
 from numpy.typing import NDArray
 
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
-from app.setup import build_backend, resolve_robot
+from app.setup.build import build_backend, resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
@@ -294,10 +293,7 @@ class LiveSimulation:
             self._event(f"push refused: {why}")
             return
         push = Push(loop.time, push_input.impulse_xy(), push_input.duration)
-        # Pushes that are over are dropped: a run without end keeps its list short.
-        ongoing = tuple(p for p in loop.scenario.pushes if p.time + p.duration > loop.time)
-        loop.scenario = replace(loop.scenario, pushes=ongoing)
-        loop.add_push(push)
+        loop.push_now(push)
         self._pushes_applied += 1
         self._event(push_line(push, "page"))
 

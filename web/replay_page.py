@@ -16,7 +16,7 @@ from typing import Any
 
 import viser
 
-from app.replay import ReplayData
+from app.results.replay import ReplayData
 
 from .page import PageView
 from .replay_source import snapshot_at

@@ -5,9 +5,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from app.stabilizer.estimator import SOURCES
 from planner.exceptions import ParameterError
-
-from .estimator import SOURCES
 
 
 @dataclass(frozen=True)

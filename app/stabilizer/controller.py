@@ -19,6 +19,12 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 
+from app.lowlevel import JointCommand, RobotMeasurement
+from app.stabilizer import centroidal
+from app.stabilizer.config import StabilizerConfig
+from app.stabilizer.estimator import RobotState, StateEstimator
+from app.stabilizer.landing import Landing
+from app.stabilizer.wrench_distribution import ContactLimits, FootContact, distribute_wrench
 from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.upper_body import UpperBodyFlywheel
@@ -28,13 +34,6 @@ from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import GRAVITY, LipmModel
 from planner.types import Foot, MeasuredState, PlannerOutput, other_foot
 from robots.description import RobotDescription
-
-from ..lowlevel import JointCommand, RobotMeasurement
-from . import centroidal
-from .config import StabilizerConfig
-from .estimator import RobotState, StateEstimator
-from .landing import Landing
-from .wrench_distribution import ContactLimits, FootContact, distribute_wrench
 
 CONTACT_LOAD = 0.05  # [-, of m g] a foot carrying more is on the ground
 ACCELERATION_FILTER = 0.02  # [s] low-pass of the IK's joint accelerations

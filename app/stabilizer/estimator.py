@@ -22,10 +22,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from app.lowlevel import RobotMeasurement
 from kinematics.robot_model import RobotModel
 from planner.exceptions import ParameterError
-
-from ..lowlevel import RobotMeasurement
 
 SOURCES = ("truth", "odometry")
 

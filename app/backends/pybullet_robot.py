@@ -1,0 +1,360 @@
+"""A biped in its own PyBullet world: loading, its sensors and its joint motors.
+
+One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
+coexist in a process), a flat ground with friction, and the robot loaded from the
+derived URDF with the URDF's inertias, its fixed-joint links merged into their
+parents (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per
+physics step; a ground contact of the head is reported as one of ``torso_link``).
+PyBullet's own joint motors are off (``VELOCITY_CONTROL`` with zero force): the
+joints are torque-driven by :class:`app.backends.joint_motors.JointMotors`, the G1's low-level
+PD law with feed-forward, at every physics step (:meth:`actuate`); :meth:`measure`
+gives the low-level measurement record (:mod:`app.lowlevel`).
+Frames: PyBullet's base pose is the base link's *inertial* frame;
+:meth:`base_pose` converts it to the URDF base frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+from numpy.typing import NDArray
+
+from app.backends.joint_motors import JointMotors
+from app.lowlevel import FootForce, JointCommand, RobotMeasurement
+from kinematics.native_output import native_output_silenced
+from kinematics.robot_model import RobotModel
+from robots.description import RobotDescription
+from robots.urdf_cache import derived_urdf
+
+with native_output_silenced():  # pybullet prints its build time when first imported
+    import pybullet
+    import pybullet_data
+    from pybullet_utils.bullet_client import BulletClient
+
+GRAVITY = 9.81  # [m/s^2]
+
+
+class SimulatedRobot:
+    """The robot and the ground in one PyBullet client.
+
+    Attributes:
+        joint_names: Actuated (revolute) joint names, in PyBullet index order.
+        link_masses: Mass of each body part [kg]; index 0 is the base.
+        mass: Total mass [kg].
+        foot_links: Foot -> PyBullet link index of its ankle link.
+        time_step: PyBullet's fixed time step [s] (the description's).
+        time: Simulated time [s].
+    """
+
+    def __init__(self, description: RobotDescription) -> None:
+        self.description = description
+        self.time_step = description.physics_time_step
+        with native_output_silenced():  # pybullet prints "argv[0]=" at connect
+            self.client = BulletClient(connection_mode=pybullet.DIRECT)
+        client = self.client
+        client.setGravity(0.0, 0.0, -GRAVITY)
+        client.setPhysicsEngineParameter(
+            fixedTimeStep=description.physics_time_step,
+            numSolverIterations=description.solver_iterations,
+            deterministicOverlappingPairs=1,
+        )
+        client.setAdditionalSearchPath(pybullet_data.getDataPath())
+        self.ground = client.loadURDF("plane.urdf", useFixedBase=True)
+        client.changeDynamics(self.ground, -1, lateralFriction=description.ground_friction)
+        flags = pybullet.URDF_USE_INERTIA_FROM_FILE
+        urdf = derived_urdf(description, merged=True)
+        self.body = client.loadURDF(str(urdf), [0, 0, 1], flags=flags)
+
+        self.joint_indices: list[int] = []
+        self.joint_names: list[str] = []
+        link_index = {client.getBodyInfo(self.body)[0].decode(): -1}
+        for index in range(client.getNumJoints(self.body)):
+            info = client.getJointInfo(self.body, index)
+            link_index[info[12].decode()] = index
+            if info[2] == pybullet.JOINT_REVOLUTE:
+                self.joint_indices.append(index)
+                self.joint_names.append(info[1].decode())
+            client.setJointMotorControl2(self.body, index, pybullet.VELOCITY_CONTROL, force=0.0)
+        self._link_names = {index: name for name, index in link_index.items()}
+        self.foot_links = {
+            foot: link_index[description.ankle_link(foot)] for foot in ("left", "right")
+        }
+        for link in self.foot_links.values():
+            client.changeDynamics(
+                self.body,
+                link,
+                lateralFriction=description.ground_friction,
+                spinningFriction=description.sole_spinning_friction,
+                frictionAnchor=1,
+            )
+        self.link_count = client.getNumJoints(self.body)
+        self.link_masses = np.array(
+            [client.getDynamicsInfo(self.body, link)[0] for link in range(-1, self.link_count)]
+        )
+        self.mass = float(self.link_masses.sum())
+        base_info = client.getDynamicsInfo(self.body, -1)
+        self._base_inertial = (base_info[3], base_info[4])
+        # The module functions with the client id: BulletClient's per-call
+        # attribute lookup (a functools.partial each time) costs ~1 us per call.
+        self._client_id = client._client
+        self._set_motors = pybullet.setJointMotorControlArray
+        self._step_simulation = pybullet.stepSimulation
+        self._contacts: tuple | None = None  # contact points of the current state
+        self.time = 0.0
+        model = RobotModel(description)
+        # The low-level interface orders joints as the rigid-body model does.
+        self._model_indices = [
+            self.joint_indices[self.joint_names.index(name)] for name in model.joint_names
+        ]
+        self.motors = JointMotors(model, self.time_step)
+        self._motor_target = np.zeros(len(self.joint_names))
+
+    # ----------------------------------------------------------------- state
+    def set_configuration(
+        self,
+        base_position: NDArray[np.float64],
+        base_quaternion_xyzw: Sequence[float],
+        joint_angles: Mapping[str, float],
+        base_linear_velocity: NDArray[np.float64] | None = None,
+        base_angular_velocity: NDArray[np.float64] | None = None,
+        joint_velocities: Mapping[str, float] | None = None,
+    ) -> None:
+        """Teleport the robot to a configuration of its URDF base frame.
+
+        Args:
+            base_position: Base frame origin [m].
+            base_quaternion_xyzw: Base frame orientation.
+            joint_angles: Joint name -> angle [rad] (missing: 0).
+            base_linear_velocity: Velocity of the base frame origin [m/s].
+            base_angular_velocity: Base angular velocity in the world [rad/s].
+            joint_velocities: Joint name -> velocity [rad/s] (missing: 0).
+        """
+        position, orientation = self.client.multiplyTransforms(
+            list(base_position), list(base_quaternion_xyzw), *self._base_inertial
+        )
+        self.client.resetBasePositionAndOrientation(self.body, position, orientation)
+        linear = np.zeros(3) if base_linear_velocity is None else base_linear_velocity
+        angular = np.zeros(3) if base_angular_velocity is None else base_angular_velocity
+        # PyBullet's base velocity is that of the inertial frame origin.
+        offset = np.array(position) - np.asarray(base_position, float)
+        linear = np.asarray(linear, float) + np.cross(angular, offset)
+        self.client.resetBaseVelocity(self.body, list(linear), list(angular))
+        self._contacts = None
+        velocities = joint_velocities or {}
+        for name, index in zip(self.joint_names, self.joint_indices, strict=True):
+            self.client.resetJointState(
+                self.body, index, joint_angles.get(name, 0.0), velocities.get(name, 0.0)
+            )
+
+    def base_pose(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Position [m] and quaternion (x, y, z, w) of the URDF base frame."""
+        position, orientation = self.client.getBasePositionAndOrientation(self.body)
+        inverse = self.client.invertTransform(*self._base_inertial)
+        frame_position, frame_orientation = self.client.multiplyTransforms(
+            position, orientation, *inverse
+        )
+        return np.array(frame_position), np.array(frame_orientation)
+
+    def joint_angles(self) -> dict[str, float]:
+        """Joint name -> measured angle [rad]."""
+        states = self.client.getJointStates(self.body, self.joint_indices)
+        return {name: state[0] for name, state in zip(self.joint_names, states, strict=True)}
+
+    def com_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Whole-body CoM position [m] and velocity [m/s] in the world, shape (3,) each."""
+        base_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        base_velocity, _ = self.client.getBaseVelocity(self.body)
+        # Forward kinematics of the current state: PyBullet's cached link states are
+        # those of the step before.
+        states = self.client.getLinkStates(
+            self.body, list(range(self.link_count)), computeLinkVelocity=1,
+            computeForwardKinematics=1,
+        )  # fmt: skip
+        positions = np.array([base_position] + [state[0] for state in states])
+        velocities = np.array([base_velocity] + [state[6] for state in states])
+        com = self.link_masses @ positions / self.mass
+        com_velocity = self.link_masses @ velocities / self.mass
+        return com, com_velocity
+
+    def ground_contacts(self) -> set[int]:
+        """PyBullet link indices touching the ground (-1: the base)."""
+        return {point[3] for point in self.contact_points()}
+
+    def contact_points(self) -> tuple:
+        """PyBullet's contact points between the robot and the ground, fetched once per
+        physics state (the fall check and the CoP measurement of a tick share them)."""
+        if self._contacts is None:
+            self._contacts = self.client.getContactPoints(bodyA=self.body, bodyB=self.ground)
+        return self._contacts
+
+    def feet_in_contact(self) -> set[str]:
+        """Feet whose ankle link touches the ground."""
+        contacts = self.ground_contacts()
+        return {foot for foot, link in self.foot_links.items() if link in contacts}
+
+    def foot_pressure(self) -> dict[str, tuple[NDArray[np.float64], float]]:
+        """Foot -> (CoP on the ground [m], shape (2,), normal force [N]) of its contacts.
+
+        Feet without contact are absent.
+        """
+        sums: dict[int, list[float]] = {}
+        for point in self.contact_points():
+            entry = sums.setdefault(point[3], [0.0, 0.0, 0.0])
+            force = point[9]
+            entry[0] += force * point[6][0]
+            entry[1] += force * point[6][1]
+            entry[2] += force
+        result = {}
+        for foot, link in self.foot_links.items():
+            total = sums.get(link, [0.0, 0.0, 0.0])
+            if total[2] > 1e-6:
+                result[foot] = (np.array(total[:2]) / total[2], total[2])
+        return result
+
+    def link_name(self, link: int) -> str:
+        """URDF name of PyBullet link index ``link`` (-1: the base)."""
+        return self._link_names.get(link, str(link))
+
+    def _foot_frame(
+        self, foot: str, forward_kinematics: bool
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World position [m] and rotation of ``foot``'s ankle link frame.
+
+        ``forward_kinematics``: update the link transforms from the joint state
+        first. PyBullet then also refreshes the bodies' collision transforms, which
+        changes the next step's contact solution slightly: an observer that must
+        not perturb the run (the physics log) passes False and reads the
+        transforms of the last step.
+        """
+        state = self.client.getLinkState(
+            self.body, self.foot_links[foot], computeForwardKinematics=int(forward_kinematics)
+        )
+        rotation = np.array(self.client.getMatrixFromQuaternion(state[5])).reshape(3, 3)
+        return np.array(state[4]), rotation
+
+    def sole_frame(
+        self, foot: str, forward_kinematics: bool = True
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """World position [m] and rotation of ``foot``'s sole frame
+        (``forward_kinematics``: see :meth:`_foot_frame`)."""
+        origin, rotation = self._foot_frame(foot, forward_kinematics)
+        return origin + rotation @ np.array(self.description.sole_offset), rotation
+
+    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
+        """World position [m] of the sole frame origin of ``foot``, shape (3,)."""
+        return self.sole_frame(foot, forward_kinematics)[0]
+
+    def sole_yaw(self, foot: str) -> float:
+        """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
+        _, rotation = self._foot_frame(foot, True)
+        return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
+    # ------------------------------------------------------- torque control
+    def measure(self) -> RobotMeasurement:
+        """Encoders, IMU, foot forces and the base's true pose and velocity (joints in
+        the rigid-body model's order, :class:`kinematics.robot_model.RobotModel`)."""
+        states = self.client.getJointStates(self.body, self._model_indices)
+        position, quaternion = self.base_pose()
+        inertial_position, _ = self.client.getBasePositionAndOrientation(self.body)
+        linear, angular = self.client.getBaseVelocity(self.body)
+        rotation = np.array(self.client.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+        # PyBullet's base velocity is that of the inertial frame origin.
+        origin_velocity = np.array(linear) + np.cross(
+            angular, position - np.array(inertial_position)
+        )
+        forces = {
+            foot: FootForce(force, cop) for foot, (cop, force) in self.foot_pressure().items()
+        }
+        return RobotMeasurement(
+            time=self.time,
+            joint_positions=np.array([s[0] for s in states]),
+            joint_velocities=np.array([s[1] for s in states]),
+            base_orientation=np.asarray(quaternion, float),
+            base_angular_velocity=rotation.T @ np.asarray(angular, float),
+            foot_forces=forces,
+            base_position=np.asarray(position, float),
+            base_linear_velocity=origin_velocity,
+        )
+
+    def set_motor_target(self, angles: NDArray[np.float64]) -> None:
+        """Where the next tick's target angles start from [rad] (after a reset)."""
+        self._motor_target = np.asarray(angles, float).copy()
+
+    def actuate(
+        self,
+        command: JointCommand,
+        measurement: RobotMeasurement,
+        steps: int,
+        expected_contact_force: NDArray[np.float64],
+        base_force_world: NDArray[np.float64] | None = None,
+        observer: Callable[[SimulatedRobot, NDArray[np.float64] | None], None] | None = None,
+    ) -> None:
+        """Run ``steps`` physics steps with the motors on ``command`` (torque control).
+
+        ``measurement`` is the state at the start of the tick (the motors' model
+        uses its true base state); ``expected_contact_force`` is J^T f of the contact
+        forces expected over the tick (:mod:`app.backends.joint_motors`). ``base_force_world``
+        [N] pushes the pelvis; ``observer`` is called after each physics step.
+        """
+        motors = self.motors
+        model = motors.model
+        q = np.concatenate(
+            [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
+        )
+        rotation = np.array(
+            self.client.getMatrixFromQuaternion(measurement.base_orientation)
+        ).reshape(3, 3)
+        v = np.concatenate(
+            [
+                rotation.T @ measurement.base_linear_velocity,
+                measurement.base_angular_velocity,
+                measurement.joint_velocities,
+            ]
+        )
+        model.update(q, v)
+        motors.prepare(command, self._motor_target, expected_contact_force)
+        self._motor_target = command.position.copy()
+        for step in range(1, steps + 1):
+            states = pybullet.getJointStates(
+                self.body, self._model_indices, physicsClientId=self._client_id
+            )
+            torques = motors.torques(
+                step / steps,
+                np.array([s[0] for s in states]),
+                np.array([s[1] for s in states]),
+            )
+            self._set_motors(
+                self.body,
+                self._model_indices,
+                pybullet.TORQUE_CONTROL,
+                forces=torques.tolist(),
+                physicsClientId=self._client_id,
+            )
+            self.step(base_force_world)
+            if observer is not None:
+                observer(self, base_force_world)
+
+    def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
+        """One physics step (``time_step`` [s]) with a force [N] on the base CoM.
+
+        PyBullet clears external forces after each step, so a push lasting several
+        steps must be applied at every step. ``None`` (or a zero force) applies none.
+        """
+        if base_force_world is not None and any(base_force_world):
+            position, _ = self.client.getBasePositionAndOrientation(self.body)
+            self.client.applyExternalForce(
+                self.body, -1, list(base_force_world), position, pybullet.WORLD_FRAME
+            )
+        self._step_simulation(physicsClientId=self._client_id)
+        self._contacts = None
+        self.time += self.time_step
+
+    def close(self) -> None:
+        """Disconnect the PyBullet client (idempotent)."""
+        if self.client is not None:
+            try:
+                self.client.disconnect()
+            except pybullet.error:
+                pass
+            self.client = None  # type: ignore[assignment]

@@ -1,0 +1,209 @@
+"""The options the ``rsg`` commands share, and the argparse types that check them.
+
+Every type turns bad text into a one-line error that names the option, the value and
+what is allowed (docs/input-validation.md); none raises a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import NoReturn
+
+from app.results.folder import MAX_PATH_LENGTH
+from app.scenarios import MAX_DURATION, parse_push
+from app.setup.overrides import MAX_VALUE_LENGTH, parse_decimal
+from app.setup.paper_rules import PAPER_RULES_HELP
+from planner.exceptions import RsgError
+from planner.types import Push
+
+MODELS = ("lipm", "pybullet")
+
+
+class CommandParser(argparse.ArgumentParser):
+    """An argparse parser whose errors are one line (no usage block), with a pointer to
+    ``--help``."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def csv_names(text: str) -> tuple[str, ...]:
+    """``a, b,c`` -> ``("a", "b", "c")`` (empty parts dropped)."""
+    return tuple(part.strip() for part in text.split(",") if part.strip())
+
+
+def decimal_argument(name: str) -> Callable[[str], float]:
+    """argparse type of a number option ``name``: a finite ASCII decimal."""
+
+    def parse(text: str) -> float:
+        value = parse_decimal(text.strip())
+        if value is None:
+            raise argparse.ArgumentTypeError(f"{name}={text[:60]!r}: a finite decimal number")
+        return value
+
+    return parse
+
+
+def decimals_argument(name: str, example: str, count: int | None = None) -> Callable:
+    """argparse type of a comma-separated list of finite decimals (``count`` of them
+    when given), e.g. ``--impulses 4,6,8``; ``example`` shows one in the error."""
+
+    def parse(text: str) -> tuple[float, ...]:
+        values = tuple(parse_decimal(part) for part in csv_names(text))
+        if not values or any(v is None for v in values) or count not in (None, len(values)):
+            raise argparse.ArgumentTypeError(f"{name}={text[:60]!r}: numbers like {example}")
+        return values  # type: ignore[return-value]
+
+    return parse
+
+
+def push_argument(text: str) -> Push:
+    """argparse type of ``--push T:IX,IY[:D]``."""
+    try:
+        return parse_push(text)
+    except RsgError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def simulated_seconds(text: str) -> float:
+    """argparse type of ``--duration`` of a run: seconds in (0, MAX_DURATION]."""
+    value = parse_decimal(text.strip())
+    if value is None or not 0.0 < value <= MAX_DURATION:
+        raise argparse.ArgumentTypeError(
+            f"--duration={text[:60]!r}: expected seconds in (0, {MAX_DURATION:g}]"
+        )
+    return value
+
+
+def parse_assignment(text: str) -> tuple[str, str]:
+    """argparse type of ``--set``: ``NAME=VALUE`` -> (name, value text)."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(
+            f"--set {text[:60]!r}: NAME=VALUE, e.g. --set swing_preparation_time=0.3"
+        )
+    if len(value) > MAX_VALUE_LENGTH:
+        raise argparse.ArgumentTypeError(
+            f"--set {name.strip()[:60]}: a value of {len(value)} characters; at most "
+            f"{MAX_VALUE_LENGTH}"
+        )
+    return name.strip(), value.strip()
+
+
+def out_argument(text: str) -> Path:
+    """argparse type of ``--out``: a non-empty path without NUL bytes."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(
+            f"--out {text!r}: expected a folder path (an empty one would write into the "
+            "current directory; use --out . for that)"
+        )
+    if "\0" in text or len(text) > MAX_PATH_LENGTH:
+        raise argparse.ArgumentTypeError(
+            f"--out {text[:60]!r}...: expected a path without NUL bytes, at most "
+            f"{MAX_PATH_LENGTH} characters"
+        )
+    return Path(text)
+
+
+def add_model_and_robot(parser: argparse.ArgumentParser, default_model: str) -> None:
+    """``--model`` and ``--robot``."""
+    parser.add_argument(
+        "--model",
+        choices=MODELS,
+        default=default_model,
+        help=f"simulation backend (default: {default_model})",
+    )
+    add_robot_argument(parser)
+
+
+def add_robot_argument(parser: argparse.ArgumentParser) -> None:
+    """``--robot`` (default ``None``: G1 on ``pybullet``, the paper's point mass on
+    ``lipm``)."""
+    parser.add_argument(
+        "--robot",
+        default=None,
+        help="robot (default: g1 on --model pybullet; on --model lipm the paper's point "
+        "mass, or with --robot that robot's planner: its mass, sole, gait and timing on "
+        "the point mass)",
+    )
+
+
+def add_controllers(
+    parser: argparse.ArgumentParser, allowed: tuple[str, ...], default: str
+) -> None:
+    """``--controllers a,b``: comma-separated names of ``allowed``."""
+    parser.add_argument(
+        "--controllers",
+        type=csv_names,
+        default=csv_names(default),
+        help=f"comma-separated, of {', '.join(allowed)} (default: {default})",
+    )
+
+
+def add_set_argument(parser: argparse.ArgumentParser) -> None:
+    """The repeatable ``--set NAME=VALUE``."""
+    parser.add_argument(
+        "--set",
+        dest="overrides",
+        type=parse_assignment,
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="change one parameter: a robot description field, a PyBullet backend option "
+        "or an RSG parameter, e.g. --set swing_preparation_time=0.3 --set landing_depth=0.003 "
+        "(repeatable; a wrong name lists the allowed ones, a value out of range gives the "
+        "range)",
+    )
+
+
+def add_paper_rules(parser: argparse.ArgumentParser) -> None:
+    """``--paper-rules``: the paper's algorithm, every extension off."""
+    parser.add_argument("--paper-rules", action="store_true", help=PAPER_RULES_HELP)
+
+
+def add_out_arguments(parser: argparse.ArgumentParser, what: str = "the results") -> None:
+    """``--out`` (required) and ``--overwrite``."""
+    parser.add_argument("--out", type=out_argument, required=True, help=f"folder for {what}")
+    parser.add_argument(
+        "--overwrite",
+        action="store_true",
+        help="--out may hold an earlier run's results: they are deleted first (without it "
+        "such a folder is refused, so results are never mixed)",
+    )
+
+
+def add_workers(parser: argparse.ArgumentParser, backends: bool = True) -> None:
+    """``--workers`` and, when ``backends``, ``--backend process|ray``."""
+    parser.add_argument(
+        "--workers",
+        type=int,
+        default=None,
+        help="parallel workers (default: the CPU count; at most 4 per CPU, and never more "
+        "than there are jobs)",
+    )
+    if backends:
+        parser.add_argument(
+            "--backend",
+            choices=("process", "ray"),
+            default="process",
+            help="process (default) or ray (needs the 'ray' extra)",
+        )
+
+
+def add_job_options(parser: argparse.ArgumentParser) -> None:
+    """The options of every command that runs resumable jobs (``sweep``, ``pushes``,
+    ``protocol``): ``--paper-rules``, ``--workers``, ``--backend``, ``--out``, ``--set``,
+    ``--quiet``."""
+    add_paper_rules(parser)
+    add_workers(parser)
+    add_out_arguments(parser, "the results (a folder of the same command is resumed)")
+    add_set_argument(parser)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def workers_of(args: argparse.Namespace) -> int:
+    """``--workers``, by default the CPU count."""
+    return args.workers if args.workers is not None else os.cpu_count() or 1

@@ -1,0 +1,134 @@
+"""``rsg pushes``: command-line options and the command (see :mod:`app.experiments.campaign`)."""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from app.commands.arguments import (
+    add_controllers,
+    add_job_options,
+    add_model_and_robot,
+    decimals_argument,
+    workers_of,
+)
+from app.experiments.campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
+from app.experiments.campaign_report import format_summary, push_rows, summarize, write_campaign
+from app.experiments.sweep import SWEEP_CONTROLLERS
+from app.setup.build import check_robot_overrides
+from planner.exceptions import RsgError
+
+EPILOG = """\
+examples:
+  rsg pushes --seed dev --out results/pushes-g1-dev          # G1: 100 pushes, rsg and no-step
+  rsg pushes --seed eval --out results/pushes-g1-eval        # reported figures only
+  rsg pushes --robot talos --controllers rsg --pushes 24 --seed eval --out results/talos
+  rsg pushes --model lipm --robot g1 --pushes 200 --out results/pushes-g1-lipm
+
+seeds: dev (= 1) for development and tuning, eval (= 2) for reported figures only.
+
+outputs in --out:
+  campaign.json    specification, definitions, summary per controller, every push
+  campaign.csv     one row per push: draw, velocity change, per controller and twin:
+                   outcome, fall reason, adjusted steps, steps until V_u < gamma_v
+  campaign.png     outcome by direction (angle) and phase (radius), robot and twin
+  jobs.jsonl, campaign_spec.json   finished runs; the same command again resumes
+"""
+
+
+def _seed(text: str) -> int:
+    try:
+        return parse_seed(text)
+    except RsgError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    """Add ``rsg pushes`` to the subcommands."""
+    p = sub.add_parser(
+        "pushes",
+        help="push campaign: random pushes over a whole gait cycle, each beside its LIPM twin",
+        description="Draw N random pushes from a seed (direction uniform, start time uniform "
+        "over one gait cycle after a settled walk, impulse and duration uniform in ranges), run "
+        "each with every controller and on the LIPM with the same robot's planner (the twin), "
+        "and report recovered / survived / fell, adjusted steps and steps to settle.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    add_model_and_robot(p, "pybullet")
+    add_controllers(p, SWEEP_CONTROLLERS, "rsg,no-step")
+    p.add_argument(
+        "--pushes", type=int, default=CampaignSpec.pushes, help="number of pushes (default 100)"
+    )
+    p.add_argument(
+        "--seed",
+        type=_seed,
+        default=SEEDS["dev"],
+        metavar="dev|eval|N",
+        help="seed of the draws: dev (1, default) to develop, eval (2) to report",
+    )
+    p.add_argument(
+        "--impulse",
+        type=decimals_argument("--impulse", "5,10", count=2),
+        default=None,
+        metavar="LOW,HIGH",
+        help="impulse range [N s] (default 5,10 on G1, times m / 33.3 kg on other robots)",
+    )
+    p.add_argument(
+        "--duration",
+        type=decimals_argument("--duration", "0.05,0.2", count=2),
+        default=CampaignSpec.duration,
+        metavar="LOW,HIGH",
+        help="push duration range [s] (default 0.05,0.2)",
+    )
+    p.add_argument(
+        "--cycle",
+        type=int,
+        default=CampaignSpec.cycle,
+        help="the push starts after the touchdown of this step (default 4: 3.17 s on G1)",
+    )
+    p.add_argument(
+        "--settle",
+        type=float,
+        default=CampaignSpec.settle,
+        help="simulated time after the push start [s] (default 8)",
+    )
+    p.add_argument("--no-plots", action="store_true", help="skip campaign.png")
+    add_job_options(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Run ``rsg pushes``; returns 0."""
+    spec = CampaignSpec(
+        model=args.model,
+        robot=args.robot,
+        controllers=args.controllers,
+        pushes=args.pushes,
+        seed=args.seed,
+        impulse=args.impulse,
+        duration=args.duration,
+        cycle=args.cycle,
+        settle=args.settle,
+        paper_rules=args.paper_rules,
+        overrides=tuple(args.overrides),
+    )
+    if spec.model == "pybullet":
+        check_robot_overrides(spec.robot, spec.overrides)
+    workers = workers_of(args)
+    started = time.perf_counter()
+    pushes, records = run_campaign(
+        spec, args.out, workers, args.backend, not args.quiet, args.overwrite
+    )
+    wall_time = time.perf_counter() - started
+    rows = push_rows(spec, pushes, records)
+    summary = summarize(spec, rows)
+    paths = write_campaign(args.out, spec, rows, summary, wall_time)
+    if not args.no_plots:
+        from app.experiments.plots import plot_campaign
+
+        paths.append(plot_campaign(spec, rows, args.out / "campaign.png"))
+    for path in paths:
+        print(f"wrote {path}")
+    print(format_summary(spec, summary))
+    print(f"pushes: {len(campaign_jobs(spec))} runs, {wall_time:.0f} s wall time")
+    return 0

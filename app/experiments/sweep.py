@@ -1,0 +1,363 @@
+"""``rsg sweep``: the largest recovered impulse per controller, direction and push phase.
+
+Jobs: one job is (controller, direction, phase). It bisects the impulse magnitude
+[N s] of a single push along the direction between 0 and ``bracket`` times the
+capture bound (:mod:`app.experiments.capturability`, an upper limit for any controller on the
+LIPM) and returns the largest impulse that is still recovered, to ``tolerance``.
+Recovery is assumed monotone in the magnitude.
+
+Push phase: the LIPM walk starts in single support on the left foot at s~ = T_DSP,
+so nominal step k (k = 1, 2, ...) lands at t_k = T_SSP + (k - 1) T^*. Cycle k is
+[t_k, t_k + T^*) on the stance foot of step k (right for odd k). Phase p in [0, 1)
+puts the push start at t = t_k + p T^* of cycle ``cycle`` (default 3, right stance),
+i.e. at s~ = p T^* after the step; the run lasts ``settle`` seconds after that.
+
+Directions: n directions at angle 2 pi i / n in the world frame, 0 = forward (+x),
+90 deg = to the left (+y).
+
+Jobs run in parallel and resume after an interruption (:mod:`app.experiments.jobs`);
+a resumed sweep must agree on :data:`RESULT_FIELDS`, and every line of its
+``jobs.jsonl`` must be a job record of it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+
+from app.experiments.bisection import bisect_threshold
+from app.experiments.capture_bound import impulse_bound
+from app.experiments.jobs import run_resumable
+from app.experiments.trial import SettledTrial, measured_touchdown, push_timing
+from app.scenarios import Scenario
+from app.setup.build import resolve_robot
+from app.setup.overrides import Overrides, check_overrides
+from planner.exceptions import ParameterError
+from planner.parameters import CONTROLLERS
+from planner.types import Push
+from robots import DEFAULT_ROBOT
+
+PLACO_WPG = "placo-wpg"
+
+
+class GridLike(Protocol):
+    """What :func:`build_controller` reads of a specification."""
+
+    @property
+    def model(self) -> str: ...
+    @property
+    def robot(self) -> str | None: ...
+    @property
+    def paper_rules(self) -> bool: ...
+    @property
+    def fall_dcm_error(self) -> float: ...
+    @property
+    def overrides(self) -> Overrides: ...
+
+
+SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
+SPEC_FILE = "sweep_spec.json"
+MAX_PHASES = 100
+#: A job record's fields and their types (what the envelope and its plot read).
+RECORD_FIELDS: dict[str, type | tuple[type, ...]] = {
+    "key": str,
+    "controller": str,
+    "direction_deg": (int, float),
+    "phase": (int, float),
+    "impulse": (int, float),
+    "bound": (int, float),
+    "ratio": (int, float),
+    "capped": bool,
+    "runs": int,
+    "stance": str,
+    "push_time": (int, float),
+}
+# Fields that change a job's result: a resumed sweep must agree on them.
+RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
+                 "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
+                 "overrides", "timing")  # fmt: skip
+
+
+def check_pushes(
+    model: str,
+    controllers: tuple[str, ...],
+    directions: int,
+    phases: tuple[float, ...],
+    overrides: Overrides = (),
+    robot: str | None = None,
+) -> None:
+    """Validate what a sweep and a push grid share.
+
+    Raises:
+        ParameterError: naming the field, the value and what is allowed.
+    """
+    if model not in ("lipm", "pybullet"):
+        raise ParameterError("model", model, "lipm or pybullet")
+    bad = [c for c in controllers if c not in SWEEP_CONTROLLERS]
+    if bad or not controllers or len(set(controllers)) != len(controllers):
+        raise ParameterError(
+            "controllers", ",".join(controllers), f"distinct of {SWEEP_CONTROLLERS}"
+        )
+    if PLACO_WPG in controllers and model != "pybullet":
+        raise ParameterError(
+            "controllers",
+            PLACO_WPG,
+            "placo-wpg only with --model pybullet (it drives the full robot's IK; "
+            "on the LIPM it has no meaning)",
+        )
+    if isinstance(directions, bool) or not (isinstance(directions, int) and 1 <= directions <= 360):
+        raise ParameterError("directions", directions, "an integer in [1, 360]")
+    if not (
+        0 < len(phases) <= MAX_PHASES
+        and all(isinstance(p, float | int) and 0.0 <= p < 1.0 for p in phases)
+        and len(set(phases)) == len(phases)
+    ):
+        raise ParameterError(
+            "phases", phases, f"1 to {MAX_PHASES} distinct fractions in [0, 1) of the cycle"
+        )
+    for controller in controllers:  # every range, before any worker starts
+        check_overrides(overrides, model, robot, "rsg" if controller == PLACO_WPG else controller)
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """What to sweep.
+
+    Attributes:
+        model: ``lipm`` or ``pybullet``.
+        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on ``pybullet`` and
+            the paper's point mass on ``lipm``).
+        controllers: Controllers to compare.
+        directions: Number of push directions, evenly spaced.
+        phases: Push phases p in [0, 1) of the walking cycle.
+        duration: Push duration Delta [s].
+        cycle: Walking cycle (>= 1) in which the push starts.
+        settle: Simulated time after the push start [s].
+        tolerance: Bisection tolerance on the impulse [N s].
+        bracket: Upper end of the bisection, times the capture bound [-].
+        qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
+        criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
+        fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
+            backend's own default (0.5 m) is a heuristic below the capturable DCM
+            error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
+            rule in effect (CoM within 0.6 m of the stance ankle) by default.
+        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
+        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
+        timing: ``nominal``: the push starts at t_k + phase T^* with t_k the nominal
+            touchdown (:func:`app.experiments.trial.push_timing`); ``touchdown``: t_k is
+            the touchdown measured in the unpushed walk of each controller and model
+            (:func:`app.experiments.trial.measured_touchdown`; ``rsg protocol``).
+    """
+
+    model: str = "lipm"
+    robot: str | None = None
+    controllers: tuple[str, ...] = CONTROLLERS
+    directions: int = 16
+    phases: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
+    duration: float = 0.1
+    cycle: int = 3
+    settle: float = 6.0
+    tolerance: float = 0.25
+    bracket: float = 1.1
+    qp_solver: str = "exact"
+    criterion: str = "recovered"
+    fall_dcm_error: float = 2.0
+    paper_rules: bool = False
+    overrides: Overrides = ()
+    timing: str = "nominal"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        check_pushes(
+            self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
+        )
+        if self.timing not in ("nominal", "touchdown"):
+            raise ParameterError("timing", self.timing, "nominal or touchdown")
+        checks = {
+            "duration": (self.duration, 1e-3, 1.0),
+            "settle": (self.settle, 1.0, 60.0),
+            "tolerance": (self.tolerance, 1e-3, 50.0),
+            "bracket": (self.bracket, 0.1, 10.0),
+            "fall_dcm_error": (self.fall_dcm_error, 0.05, 100.0),
+        }
+        for name, (value, low, high) in checks.items():
+            if not (math.isfinite(value) and low <= value <= high):
+                raise ParameterError(name, value, f"a number in [{low}, {high}]")
+        if not (isinstance(self.cycle, int) and 1 <= self.cycle <= 20):
+            raise ParameterError("cycle", self.cycle, "an integer in [1, 20]")
+        if self.qp_solver not in ("exact", "proxqp"):
+            raise ParameterError("qp_solver", self.qp_solver, "exact or proxqp")
+        if self.criterion not in ("recovered", "no-fall"):
+            raise ParameterError("criterion", self.criterion, "recovered or no-fall")
+
+    def angles(self) -> list[float]:
+        """Push directions [rad]."""
+        return [2.0 * math.pi * i / self.directions for i in range(self.directions)]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One bisection: controller, direction [rad] and phase [-]."""
+
+    controller: str
+    angle: float
+    phase: float
+
+    @property
+    def key(self) -> str:
+        return f"{self.controller}|{math.degrees(self.angle):.4f}|{self.phase:.4f}"
+
+
+def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
+    """Backend, configuration and initial condition (see :func:`build_controller`)."""
+    return build_controller(spec, controller)[:3]
+
+
+def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
+    """Backend, configuration, initial condition and planner factory (None: the RSG's)
+    of ``controller`` on ``spec``'s model and robot."""
+    if controller == PLACO_WPG:
+        from app.baselines.placo_wpg import build_placo_wpg_backend
+
+        return build_placo_wpg_backend(spec.robot or DEFAULT_ROBOT, spec.overrides)
+    return (*_build_rsg(spec, controller), None)
+
+
+def _build_rsg(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
+    from app.setup.build import build_backend
+
+    backend, config, initial = build_backend(
+        spec.model, spec.robot, controller, spec.paper_rules, spec.overrides
+    )
+    if spec.model == "lipm":
+        from app.backends.lipm import LipmBackend
+
+        backend = LipmBackend(config.model, fall_dcm_error=spec.fall_dcm_error)
+    return backend, config, initial
+
+
+def run_job(spec: SweepSpec, job: Job) -> dict:
+    """Bisect one job; returns its JSON-ready record (what ``jobs.jsonl`` holds)."""
+    from app.runner import run_closed_loop
+
+    started = time.perf_counter()
+    backend, config, initial, planner = build_controller(spec, job.controller)
+    runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
+    options = {} if planner is None else {"planner": planner}
+    early = spec.model == "lipm" and spec.criterion == "recovered"
+    try:
+        t_push, sigma, since = push_timing(config, spec.cycle, job.phase)
+        if spec.timing == "touchdown":
+            touchdown = measured_touchdown(runner, backend, config, initial, spec.cycle, **options)
+            t_push = touchdown + since
+        bound = impulse_bound(config, job.angle, sigma, since, spec.duration)
+        direction = np.array([math.cos(job.angle), math.sin(job.angle)])
+        trial = None
+        if early:
+            trial = SettledTrial(
+                backend, config, initial, t_push, t_push + spec.settle, spec.qp_solver
+            )
+
+        def recovered(impulse: float) -> bool:
+            push = Push(t_push, impulse * direction, spec.duration)
+            scenario = Scenario("sweep", t_push + spec.settle, (push,))
+            if trial is not None:
+                return trial.recovered(push)
+            result = runner(backend, config, scenario, initial, qp_solver=spec.qp_solver, **options)
+            if spec.criterion == "no-fall":
+                return not result.fall.fell
+            return bool(result.recovered)
+
+        found = bisect_threshold(recovered, spec.bracket * bound, spec.tolerance)
+    finally:
+        backend.close()
+    return {
+        "key": job.key,
+        "controller": job.controller,
+        "direction_deg": math.degrees(job.angle),
+        "phase": job.phase,
+        "push_time": t_push,
+        "stance": "left" if sigma > 0 else "right",
+        "impulse": found.passed,
+        "failed_at": found.failed,
+        "capped": found.failed is None,
+        "bound": bound,
+        "ratio": found.passed / bound if bound > 0 else math.nan,
+        "mass": config.model.mass,
+        "runs": len(found.evaluations),
+        "evaluations": found.evaluations,
+        "wall_time": time.perf_counter() - started,
+    }
+
+
+def _run_job_args(args: tuple[SweepSpec, Job]) -> dict:
+    return run_job(*args)
+
+
+def _parse_record(line: bytes) -> tuple[dict | None, str]:
+    """(record, "") for a valid job record, else (None, what is wrong)."""
+    try:
+        record = json.loads(line.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        return None, type(exc).__name__
+    if not isinstance(record, dict):
+        return None, f"a JSON {type(record).__name__}, not an object"
+    for name, kind in RECORD_FIELDS.items():
+        value = record.get(name)
+        if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
+            return None, f"field {name} missing or not a {getattr(kind, '__name__', 'number')}"
+    job = Job(record["controller"], math.radians(record["direction_deg"]), record["phase"])
+    if job.key != record["key"]:
+        return None, f"key {record['key'][:40]!r} does not match its fields"
+    return record, ""
+
+
+def all_jobs(spec: SweepSpec) -> list[Job]:
+    return [
+        Job(controller, angle, phase)
+        for controller in spec.controllers
+        for phase in spec.phases
+        for angle in spec.angles()
+    ]
+
+
+def run_sweep(
+    spec: SweepSpec,
+    out: Path,
+    workers: int = 1,
+    backend: str = "process",
+    progress: bool = True,
+    jobs: list[Job] | None = None,
+    label: str = "sweep",
+    overwrite: bool = False,
+) -> list[dict]:
+    """Run (or resume) the sweep into ``out``; returns the records of all its jobs
+    (``jobs``, default :func:`all_jobs`; ``label`` names the progress bar).
+
+    Raises:
+        ParameterError: Bad workers/backend or a mismatching folder.
+        RsgError: The folder cannot be written.
+    """
+    jobs = all_jobs(spec) if jobs is None else jobs
+    arguments = {job.key: (spec, job) for job in jobs}
+    finished = run_resumable(
+        _run_job_args,
+        arguments,
+        out,
+        spec,
+        RESULT_FIELDS,
+        SPEC_FILE,
+        workers,
+        backend,
+        progress,
+        label,
+        overwrite=overwrite,
+        parse=_parse_record,
+    )
+    return [finished[job.key] for job in jobs]
