@@ -3,10 +3,10 @@ like the browser composes them, put the soles and the pelvis on the simulated on
 
 from __future__ import annotations
 
-import socket
-
 import numpy as np
 import pytest
+
+from conftest import free_port
 
 viser = pytest.importorskip("viser")
 from viser import transforms as tf  # noqa: E402
@@ -42,10 +42,7 @@ def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 @pytest.fixture(scope="module")
 def server():
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
     yield server
     server.stop()
 
