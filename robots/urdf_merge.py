@@ -30,14 +30,8 @@ from scipy.spatial.transform import Rotation
 from planner.exceptions import ParameterError
 
 Transform = tuple[NDArray[np.float64], NDArray[np.float64]]  # (rotation 3x3, translation [m])
-_INERTIA_ENTRIES = {
-    "ixx": (0, 0),
-    "ixy": (0, 1),
-    "ixz": (0, 2),
-    "iyy": (1, 1),
-    "iyz": (1, 2),
-    "izz": (2, 2),
-}
+# The <inertia> attributes ixx, ixy, ixz, iyy, iyz, izz: the symmetric tensor's upper triangle.
+_INERTIA_ENTRIES = {f"i{'xyz'[r]}{'xyz'[c]}": (r, c) for r in range(3) for c in range(r, 3)}
 
 
 def lock_joints(root: ET.Element, angles: Mapping[str, float]) -> None:

@@ -1,8 +1,15 @@
 """Shared fixtures and helpers: planner configurations and LIPM runs, built once per
 session; hand-made planner commands and a DCM feedback for full-robot tests (the
-planner's part, without the planner)."""
+planner's part, without the planner); the cache of derived URDFs in the session's
+temporary folder; servers run as subprocesses."""
 
 from __future__ import annotations
+
+import socket
+import subprocess
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -89,3 +96,46 @@ def dcm_feedback_zmp(
     omega = np.sqrt(GRAVITY / com_height)
     dcm = state.com_position + state.com_velocity / omega
     return dcm + gain / omega * (dcm - np.asarray(target, float))
+
+
+def session_cache(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """The session's RSG_CACHE_DIR: derived URDFs are built once, never in the user's cache."""
+    return str(tmp_path_factory.getbasetemp() / "cache")
+
+
+@pytest.fixture
+def cache_in_tmp(tmp_path_factory: pytest.TempPathFactory, monkeypatch: pytest.MonkeyPatch) -> None:
+    """RSG_CACHE_DIR set to :func:`session_cache` for one test."""
+    monkeypatch.setenv("RSG_CACHE_DIR", session_cache(tmp_path_factory))
+
+
+@contextmanager
+def cache_for_module(tmp_path_factory: pytest.TempPathFactory) -> Iterator[None]:
+    """RSG_CACHE_DIR set to :func:`session_cache` inside a module-scoped fixture."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RSG_CACHE_DIR", session_cache(tmp_path_factory))
+        yield
+
+
+def free_port() -> int:
+    """A TCP port free on 127.0.0.1 now."""
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+@contextmanager
+def output_lines(process: subprocess.Popen[str]) -> Iterator[list[str]]:
+    """The lines ``process`` prints, as they come; the process is killed if still running."""
+    lines: list[str] = []
+    assert process.stdout is not None
+    stdout = process.stdout
+    reader = threading.Thread(target=lambda: lines.extend(stdout), daemon=True)
+    reader.start()
+    try:
+        yield lines
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait(10)
+    reader.join(5)

@@ -336,6 +336,12 @@ def set_case(name: str, assignment: str, *expect: str, model: str = "lipm",
     return Case(f"{command}-{model}{'-' + robot if robot else ''}-{name}", argv, tuple(expect))
 
 
+def refused_value(name: str, value: str, *expect: str, **where: str) -> Case:
+    """``--set name=value`` refused with a message naming both (``where``: see set_case)."""
+    return set_case(f"{name}={value}", f"{name}={value}", f"--set {name}", f"'{value}'", *expect,
+                    **where)  # fmt: skip
+
+
 def _just_below(name: str) -> str:
     """A value just below the range of RSG parameter ``name``."""
     from planner.parameters import RANGES
@@ -354,16 +360,12 @@ def rsg_parameter_cases() -> list[Case]:
     cases = []
     for name, kind in rsg_parameter_types("lipm").items():
         if kind == "bool":
-            for value in ("maybe", "2", "nan"):
-                cases.append(set_case(f"{name}={value}", f"{name}={value}", f"--set {name}",
-                                      f"'{value}'", "true or false"))  # fmt: skip
+            cases += [refused_value(name, v, "true or false") for v in ("maybe", "2", "nan")]
             continue
         for value in ("1e300", "-1e300", _just_below(name)):
-            cases.append(set_case(f"{name}={value}", f"{name}={value}", f"--set {name}",
-                                  f"'{value}'", "a number in"))  # fmt: skip
+            cases.append(refused_value(name, value, "a number in"))
         for value in ("nan", "inf", "abc", "true", "1,2", "0x10"):
-            cases.append(set_case(f"{name}={value}", f"{name}={value}", f"--set {name}",
-                                  f"'{value}'", "finite decimal number"))  # fmt: skip
+            cases.append(refused_value(name, value, "finite decimal number"))
     return cases
 
 
@@ -374,9 +376,7 @@ def description_field_cases() -> list[Case]:
                  "single_support_duration", "angular_momentum_rate_max",
                  "lqr_dcm_error_scale", "swing_preparation_time", "filter_time_constant",
                  "step_reaction_time", "reanchor_time", "com_height"):  # fmt: skip
-        for value in ("1e300", "-1e300"):
-            cases.append(set_case(f"{name}={value}", f"{name}={value}", f"--set {name}",
-                                  f"'{value}'", robot="g1"))  # fmt: skip
+        cases += [refused_value(name, value, robot="g1") for value in ("1e300", "-1e300")]
     for name in ("physics_time_step=0.001", "solver_iterations=10", "locked_joints=none",
                  "fall_tilt=0.5", "ground_friction=0.8", "swing_height=0.05",
                  "foot_spacing=0.2", "fall_base_height=0.3", "sole_spinning_friction=0",
@@ -385,8 +385,7 @@ def description_field_cases() -> list[Case]:
                               "only with --model pybullet", robot="g1"))  # fmt: skip
     for pair in ("step_min", "step_max"):
         for value in ("1", "a,b", "1e300,1e300", "nan,0"):
-            cases.append(set_case(f"{pair}={value}", f"{pair}={value}", f"--set {pair}",
-                                  f"'{value}'", robot="g1"))  # fmt: skip
+            cases.append(refused_value(pair, value, robot="g1"))
     return cases
 
 
@@ -400,9 +399,7 @@ def backend_option_cases() -> list[Case]:
             values = ("sideways",)
         else:
             values = ("1e300", "-1e300")
-        for value in values:
-            cases.append(set_case(f"{name}={value}", f"{name}={value}", f"--set {name}",
-                                  f"'{value}'", model="pybullet"))  # fmt: skip
+        cases += [refused_value(name, value, model="pybullet") for value in values]
     return cases
 
 
@@ -592,6 +589,9 @@ def _symlinked_result(tmp: Path) -> None:
 
 
 RUN = ["run", *LIPM, "--scenario", "walk", "--duration", "0.2"]
+RUN_WITH_PLOTS = ["run", "--model", "lipm", "--quiet", "--scenario", "walk", "--duration", "0.2"]
+GRID = ["grid", "--model", "lipm", "--impulses", "5", "--directions", "1", "--quiet"]
+SWEEP = ["sweep", "--model", "lipm", "--directions", "1", "--phases", "0", "--quiet"]
 OUT_FOLDERS = [
     Case("out-empty", [*RUN, "--out", ""], ("--out ''", "folder path")),
     Case("out-blank", [*RUN, "--out", "   "], ("--out '   '", "folder path")),
@@ -641,18 +641,7 @@ OUT_FOLDERS = [
     ),
     Case(
         "out-plot-is-a-folder",
-        [
-            "run",
-            "--model",
-            "lipm",
-            "--quiet",
-            "--scenario",
-            "walk",
-            "--duration",
-            "0.2",
-            "--out",
-            "{tmp}/out",
-        ],
+        [*RUN_WITH_PLOTS, "--out", "{tmp}/out"],
         ("fig6a_top_view.png: exists and is not a file",),
         setup=_folder_named("fig6a_top_view.png"),
     ),  # fmt: skip
@@ -670,69 +659,25 @@ OUT_FOLDERS = [
     ),
     Case(
         "grid-png-is-a-folder",
-        [
-            "grid",
-            "--model",
-            "lipm",
-            "--impulses",
-            "5",
-            "--directions",
-            "1",
-            "--quiet",
-            "--out",
-            "{tmp}/out",
-        ],
+        [*GRID, "--out", "{tmp}/out"],
         ("grid.png: exists and is not a file",),
         setup=_folder_named("grid.png"),
     ),  # fmt: skip
     Case(
         "grid-earlier-results",
-        [
-            "grid",
-            "--model",
-            "lipm",
-            "--impulses",
-            "5",
-            "--directions",
-            "1",
-            "--quiet",
-            "--out",
-            "{tmp}/out",
-        ],
+        [*GRID, "--out", "{tmp}/out"],
         ("holds the results of an earlier run (summary.json)",),
         setup=_results_of_another_run,
     ),  # fmt: skip
     Case(
         "sweep-envelope-is-a-folder",
-        [
-            "sweep",
-            "--model",
-            "lipm",
-            "--directions",
-            "1",
-            "--phases",
-            "0",
-            "--quiet",
-            "--out",
-            "{tmp}/out",
-        ],
+        [*SWEEP, "--out", "{tmp}/out"],
         ("envelope.png: exists and is not a file",),
         setup=_folder_named("envelope.png"),
     ),
     Case(
         "sweep-earlier-results",
-        [
-            "sweep",
-            "--model",
-            "lipm",
-            "--directions",
-            "1",
-            "--phases",
-            "0",
-            "--quiet",
-            "--out",
-            "{tmp}/out",
-        ],
+        [*SWEEP, "--out", "{tmp}/out"],
         ("holds the results of an earlier run (summary.json)",),
         setup=_results_of_another_run,
     ),  # fmt: skip
@@ -1115,6 +1060,18 @@ def _grid_and_summary(tmp: Path) -> None:
     (tmp / "out" / "grid.json").write_text("{}\n")
 
 
+GRID_MORE_WORKERS_THAN_JOBS = [
+    "grid", "--model", "lipm", "--quiet", "--no-plots", "--controllers", "no-step", "--impulses",
+    "5", "--directions", "1", "--settle", "1", "--workers", "8", "--out", "{tmp}/out",
+]  # fmt: skip
+
+
+def _accept_push(name: str, push: str) -> Case:
+    """``--push`` accepted: the run applies it."""
+    argv = [*RUN, "--push", push, "--out", "{tmp}/out"]
+    return Case(name, argv, None, check=_check_pushes_applied(1))
+
+
 ACCEPTED = [
     Case(
         "accept-resume-half-written-last-line",
@@ -1150,81 +1107,15 @@ ACCEPTED = [
         b"duration = 0.2\npush = []\n",
         check=_check_pushes_applied(0),
     ),  # fmt: skip
-    Case(
-        "accept-push-shorter-than-a-tick",
-        [
-            "run",
-            *LIPM,
-            "--scenario",
-            "walk",
-            "--duration",
-            "0.2",
-            "--push",
-            "0.1:5,0:5e-324",
-            "--out",
-            "{tmp}/out",
-        ],
-        None,
-        check=_check_pushes_applied(1),
-    ),
-    Case(
-        "accept-push-ending-with-the-run",
-        [
-            "run",
-            *LIPM,
-            "--scenario",
-            "walk",
-            "--duration",
-            "0.2",
-            "--push",
-            "0.1:5,0:0.1",
-            "--out",
-            "{tmp}/out",
-        ],
-        None,
-        check=_check_pushes_applied(1),
-    ),
-    Case(
-        "accept-spaces-in-push",
-        [
-            "run",
-            *LIPM,
-            "--scenario",
-            "walk",
-            "--duration",
-            "0.2",
-            "--push",
-            " 0.1 : 5 , 0 ",
-            "--out",
-            "{tmp}/out",
-        ],
-        None,
-        check=_check_pushes_applied(1),
-    ),  # fmt: skip
+    _accept_push("accept-push-shorter-than-a-tick", "0.1:5,0:5e-324"),
+    _accept_push("accept-push-ending-with-the-run", "0.1:5,0:0.1"),
+    _accept_push("accept-spaces-in-push", " 0.1 : 5 , 0 "),
     Case(
         "accept-workers-above-the-job-count",
-        [
-            "grid",
-            "--model",
-            "lipm",
-            "--quiet",
-            "--no-plots",
-            "--controllers",
-            "no-step",
-            "--impulses",
-            "5",
-            "--directions",
-            "1",
-            "--settle",
-            "1",
-            "--workers",
-            "8",
-            "--out",
-            "{tmp}/out",
-        ],
+        GRID_MORE_WORKERS_THAN_JOBS,
         None,
         check=lambda code, out, err, tmp: None if code == 0 else pytest.fail(err),
-    ),  # fmt: skip
+    ),
 ]
 
 CASES = [

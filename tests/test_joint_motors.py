@@ -14,23 +14,20 @@ from app.backends.pybullet import PyBulletBackend
 from app.backends.pybullet_robot import SimulatedRobot
 from app.lowlevel import JointCommand
 from app.stabilizer.controller import joint_impedance
-from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
+from conftest import LEFT, RIGHT, cache_for_module, command, dcm_feedback_zmp
 from robots import get_robot
 
 G1 = get_robot("g1")
 TICK = 0.01  # [s] control period of the hung-robot runs
 
 
-@pytest.fixture(autouse=True)
-def _cache_in_tmp(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+pytestmark = pytest.mark.usefixtures("cache_in_tmp")
 
 
 @pytest.fixture(scope="module")
 def hung(tmp_path_factory):
     """G1 hung by its pelvis 1.2 m above the ground (a fixed constraint)."""
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+    with cache_for_module(tmp_path_factory):
         sim = SimulatedRobot(G1)
     sim.set_configuration(np.array([0.0, 0.0, 1.2]), [0, 0, 0, 1], {})
     position, orientation = sim.client.getBasePositionAndOrientation(sim.body)

@@ -10,7 +10,7 @@ import pytest
 
 from app.backends.base import InitialCondition
 from app.backends.pybullet import PyBulletBackend
-from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
+from conftest import LEFT, RIGHT, cache_for_module, command, dcm_feedback_zmp
 from planner.exceptions import ParameterError
 from planner.parameters import GRAVITY
 from planner.types import Foothold, StepEvent
@@ -19,16 +19,13 @@ from robots import get_robot
 STANDING = InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2))
 
 
-@pytest.fixture(autouse=True)
-def _cache_in_tmp(tmp_path_factory, monkeypatch):
-    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+pytestmark = pytest.mark.usefixtures("cache_in_tmp")
 
 
 @pytest.fixture(scope="module")
 def backend(tmp_path_factory):
     """One G1 for the module's tests; each test resets it."""
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+    with cache_for_module(tmp_path_factory):
         instance = PyBulletBackend("g1")
     yield instance
     instance.close()
@@ -247,8 +244,7 @@ def pushed_run(logged: bool):
 
 @pytest.fixture(scope="module")
 def pushed_runs(tmp_path_factory):
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RSG_CACHE_DIR", str(tmp_path_factory.getbasetemp() / "cache"))
+    with cache_for_module(tmp_path_factory):
         return [pushed_run(False), pushed_run(False), pushed_run(True)]
 
 

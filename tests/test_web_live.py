@@ -7,6 +7,7 @@ import time
 
 import pytest
 
+from conftest import free_port, output_lines
 from web.live import STEP_MARKS, LiveSimulation
 from web.push_input import PushInput, paper_presets
 
@@ -74,17 +75,12 @@ def test_demo_stops_cleanly_on_a_signal_even_if_started_with_sigint_ignored(sign
     SIGINT ignored; the demo still stops on SIGINT (and SIGTERM), says so and exits 0
     (before it installed its own SIGINT handler it ran on until killed)."""
     import signal
-    import socket
     import subprocess
     import sys
-    import threading
     from pathlib import Path
 
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
     demo = subprocess.Popen(
-        [sys.executable, "-m", "app", "demo", "--model", "lipm", "--port", str(port)],
+        [sys.executable, "-m", "app", "demo", "--model", "lipm", "--port", str(free_port())],
         cwd=Path(__file__).resolve().parents[1],
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
@@ -92,19 +88,10 @@ def test_demo_stops_cleanly_on_a_signal_even_if_started_with_sigint_ignored(sign
         bufsize=1,
         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
     )
-    lines: list[str] = []
-    assert demo.stdout is not None
-    reader = threading.Thread(target=lambda: lines.extend(demo.stdout), daemon=True)
-    reader.start()
-    try:
+    with output_lines(demo) as lines:
         assert wait_for(lambda: any("open http://" in line for line in lines), 120.0), lines
         demo.send_signal(getattr(signal, signum))
         assert demo.wait(30) == 0
-    finally:
-        if demo.poll() is None:
-            demo.kill()
-            demo.wait(10)
-    reader.join(5)
     assert any("rsg demo: stopped" in line for line in lines), lines
 
 

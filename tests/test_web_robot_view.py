@@ -3,10 +3,10 @@ like the browser composes them, put the soles and the pelvis on the simulated on
 
 from __future__ import annotations
 
-import socket
-
 import numpy as np
 import pytest
+
+from conftest import free_port
 
 viser = pytest.importorskip("viser")
 from viser import transforms as tf  # noqa: E402
@@ -42,10 +42,7 @@ def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
 
 @pytest.fixture(scope="module")
 def server():
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    server = viser.ViserServer(host="127.0.0.1", port=port, verbose=False)
+    server = viser.ViserServer(host="127.0.0.1", port=free_port(), verbose=False)
     yield server
     server.stop()
 
@@ -56,7 +53,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
     simulated base, and the drawn stance foot's lowest vertex on the ground."""
     from app.runner import ClosedLoop
     from app.scenarios import Scenario
-    from app.setup.build import build_backend
+    from app.setup.build.build import build_backend
     from planner.types import Push
     from robots.urdf_cache import derived_urdf
     from web.robot_view import RobotView

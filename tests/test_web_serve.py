@@ -4,23 +4,17 @@ refused on one line with exit code 2 (subprocesses, the command as a user runs i
 from __future__ import annotations
 
 import signal
-import socket
 import subprocess
 import sys
-import threading
 import time
 import urllib.request
 from pathlib import Path
 
 import pytest
 
+from conftest import free_port, output_lines
+
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def rsg(*args: str, timeout: float = 120.0) -> subprocess.CompletedProcess:
@@ -63,22 +57,13 @@ def test_replay_of_a_run_answers_http_200_on_its_port(run_folder, host):
          "--host", host],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
     )  # fmt: skip
-    lines: list[str] = []
-    assert server.stdout is not None
-    reader = threading.Thread(target=lambda: lines.extend(server.stdout), daemon=True)
-    reader.start()
-    try:
+    with output_lines(server) as lines:
         end = time.monotonic() + 60.0
         while not any("rsg replay: open" in line for line in lines) and time.monotonic() < end:
             time.sleep(0.1)
         assert http_status(f"http://127.0.0.1:{port}") == 200
         server.send_signal(signal.SIGINT)
         assert server.wait(30) == 0
-    finally:
-        if server.poll() is None:
-            server.kill()
-            server.wait(10)
-    reader.join(5)
     output = "".join(lines)
     assert f"rsg replay: open http://{host}:{port}" in output, output
     warned = "anyone who can reach port" in output

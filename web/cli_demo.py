@@ -21,6 +21,11 @@ against the Lyapunov level sets (Fig. 6(c)), V_u / gamma_v on a log axis and the
 since the last step. Push from the page (button "Push", click the ground to aim). The
 run goes on until you stop the server with Ctrl-C.
 """
+DEMO_HELP = "live browser demo: watch the robot walk and push it"
+DEMO_DESCRIPTION = (
+    "Serve a live browser demo (viser) of the closed loop: the robot walks, you push it from "
+    "the page and watch the step generator recover."
+)
 
 
 def _bounded(option: str, kind: type, low: float, high: float, unit: str):  # noqa: ANN202
@@ -44,16 +49,28 @@ PORT = _bounded("--port", int, 1, 65535, "(a TCP port)")
 _frame_rate = _bounded("--frame-rate", float, 1.0, 60.0, "[Hz]")
 
 
-def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
-    """Add ``demo`` to the subcommands ``sub`` of ``rsg``; returns its parser."""
-    demo = sub.add_parser(
-        "demo",
-        help="live browser demo: watch the robot walk and push it",
-        description="Serve a live browser demo (viser) of the closed loop: the robot walks, "
-        "you push it from the page and watch the step generator recover.",
-        epilog=DEMO_EPILOG,
+def add_page_parser(
+    sub: argparse._SubParsersAction, name: str, summary: str, description: str, epilog: str
+) -> argparse.ArgumentParser:
+    """A subcommand that serves a page (``rsg demo``, ``rsg replay``): its epilog as written."""
+    return sub.add_parser(
+        name,
+        help=summary,
+        description=description,
+        epilog=epilog,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+
+
+def add_address_arguments(parser: argparse.ArgumentParser, host_help: str) -> None:
+    """``--host`` and ``--port``: where a page is served."""
+    parser.add_argument("--host", default="127.0.0.1", help=host_help)
+    parser.add_argument("--port", type=PORT, default=8080, help="port to serve on (default: 8080)")
+
+
+def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add ``demo`` to the subcommands ``sub`` of ``rsg``; returns its parser."""
+    demo = add_page_parser(sub, "demo", DEMO_HELP, DEMO_DESCRIPTION, DEMO_EPILOG)
     demo.add_argument(
         "--model",
         choices=("pybullet", "lipm"),
@@ -72,13 +89,11 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         default="walk",
         help="built-in scenario name or .toml file; its pushes are applied too (default: walk)",
     )
-    demo.add_argument(
-        "--host",
-        default="127.0.0.1",
-        help="address to serve on (default: 127.0.0.1, this machine only; any other "
+    add_address_arguments(
+        demo,
+        "address to serve on (default: 127.0.0.1, this machine only; any other "
         "address lets whoever reaches the port push the robot)",
     )
-    demo.add_argument("--port", type=PORT, default=8080, help="port to serve on (default: 8080)")
     demo.add_argument(
         "--frame-rate",
         type=_frame_rate,

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from .cli_demo import PORT
+from .cli_demo import add_address_arguments, add_page_parser
 
 REPLAY_EPILOG = """\
 examples:
@@ -21,25 +21,18 @@ arrows) for the recorded run, with a time slider, Play/Pause and the speed; noth
 simulated. rsg sweep and rsg grid keep their worst runs replayable (their reports say
 where). Ctrl-C stops the server.
 """
+REPLAY_HELP = "replay a recorded run in the browser (the --out folder of rsg run)"
+REPLAY_DESCRIPTION = (
+    "Serve the browser page of a recorded run: the robot, its footholds and the plots at any "
+    "time of the run, with a time slider, Play/Pause and speed."
+)
 
 
 def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     """Entry-point hook: add ``replay`` to ``rsg``."""
-    replay = sub.add_parser(
-        "replay",
-        help="replay a recorded run in the browser (the --out folder of rsg run)",
-        description="Serve the browser page of a recorded run: the robot, its footholds and "
-        "the plots at any time of the run, with a time slider, Play/Pause and speed.",
-        epilog=REPLAY_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    replay = add_page_parser(sub, "replay", REPLAY_HELP, REPLAY_DESCRIPTION, REPLAY_EPILOG)
     replay.add_argument("folder", type=Path, metavar="DIR", help="a run folder (with replay.npz)")
-    replay.add_argument(
-        "--host",
-        default="127.0.0.1",
-        help="address to serve on (default: 127.0.0.1, this machine only)",
-    )
-    replay.add_argument("--port", type=PORT, default=8080, help="port to serve on (default: 8080)")
+    add_address_arguments(replay, "address to serve on (default: 127.0.0.1, this machine only)")
     return replay
 
 

@@ -18,7 +18,6 @@ changes the push; the push arrow shows while a push acts.
 from __future__ import annotations
 
 import html
-import threading
 import time as wallclock
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -46,7 +45,7 @@ from .push_input import (
 )
 from .scene_model import direction_towards, push_arrow, ray_ground_intersection
 from .snapshot import Snapshot
-from .worker import Worker
+from .worker import FrameLoop
 
 Array = NDArray[np.float64]
 
@@ -86,7 +85,7 @@ class _Field:
     typed_at: float = 0.0
 
 
-class DemoPage:
+class DemoPage(FrameLoop):
     """The live demo's page on a viser server, driven by a live simulation.
 
     Args:
@@ -109,9 +108,8 @@ class DemoPage:
     ) -> None:
         self.server = server
         self.live = live
-        self.frame_rate = frame_rate
+        super().__init__(frame_rate, "rsg-page")
         self._log = log or (lambda line: print(line, flush=True))
-        self._worker = Worker(self._run, "rsg-page")
         self._last_serial = -1
         self._dirty = True
         self._frames: list[float] = []
@@ -297,33 +295,22 @@ class DemoPage:
             self._aimed()
 
     # ---------------------------------------------------------------- render thread
-    def start(self) -> None:
-        """Start updating the page (idempotent)."""
-        self._worker.start()
-
-    def stop(self, timeout: float = 5.0) -> None:
-        """Stop updating the page."""
-        self._worker.stop(timeout)
-
-    def _run(self, stop: threading.Event) -> None:
-        period = 1.0 / self.frame_rate
-        last = wallclock.perf_counter()
-        while not stop.is_set():
-            start = wallclock.perf_counter()
-            self._settle_fields(start)
-            snap = self.live.snapshot()
-            aiming = start < self._aim_until
-            if snap.serial != self._last_serial or self._dirty or aiming:
-                self._dirty = aiming  # one more frame once the aim arrow expires
-                self._last_serial = snap.serial
-                try:
-                    self.update(snap, start - last)
-                except Exception as exc:  # noqa: BLE001 - keep the page alive, say why
-                    self.view.set_status([f"page update failed: {html.escape(repr(exc))}"])
-                last = start
-                self._frames = [t for t in self._frames if t > start - 1.0] + [start]
-                self.update_rate = float(len(self._frames))
-            stop.wait(max(0.0, period - (wallclock.perf_counter() - start)))
+    def _frame(self, now: float, dt: float) -> bool:
+        """Draw when there is something new (a snapshot, a change, the aim arrow)."""
+        self._settle_fields(now)
+        snap = self.live.snapshot()
+        aiming = now < self._aim_until
+        if snap.serial == self._last_serial and not self._dirty and not aiming:
+            return False
+        self._dirty = aiming  # one more frame once the aim arrow expires
+        self._last_serial = snap.serial
+        try:
+            self.update(snap, dt)
+        except Exception as exc:  # noqa: BLE001 - keep the page alive, say why
+            self.view.set_status([f"page update failed: {html.escape(repr(exc))}"])
+        self._frames = [t for t in self._frames if t > now - 1.0] + [now]
+        self.update_rate = float(len(self._frames))
+        return True
 
     def update(self, snap: Snapshot, dt: float) -> None:
         """Show ``snap`` (status, scene, plots)."""

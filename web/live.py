@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
-from app.setup.build import build_backend, resolve_robot
+from app.setup.build.build import build_backend, resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
@@ -32,12 +32,13 @@ from .push_input import PushInput, push_refusal
 from .scene_model import ControllerState, StepMark, Trail
 from .snapshot import (
     DCM_ERROR_TRAIL_TIME,
-    FOOT_MARGIN,
     PLOT_TIME,
+    STEP_MARKS,
     TRAIL_TIME,
     PageStatus,
     RobotPose,
     Snapshot,
+    sole_corners,
 )
 from .worker import Worker
 
@@ -48,7 +49,6 @@ PUBLISH_PERIOD = 1.0 / 60.0  # [s] wall time between snapshots while running
 LAG_LIMIT = 0.25  # [s] simulated lag after which pacing restarts (machine too slow)
 SPEED_WINDOW = 1.0  # [s] wall time over which the speed is measured
 SLOW_MOTION_FACTORS = (1.0, 0.5, 0.25, 0.1)  # [-] simulated seconds per wall second
-STEP_MARKS = 50  # past steps kept for the drawing
 
 
 def push_line(push: Push, source: str) -> str:
@@ -174,9 +174,10 @@ class LiveSimulation:
         self._loop = ClosedLoop(backend, config, scenario, initial, record=False)
         self._controller = controller
         self._config = config
-        margin = np.array([FOOT_MARGIN, FOOT_MARGIN])
-        self._foot_lower = np.array(config.constraints.zmp_window_min) - margin
-        self._foot_upper = np.array(config.constraints.zmp_window_max) + margin
+        window = config.constraints
+        self._foot_lower, self._foot_upper = sole_corners(
+            window.zmp_window_min, window.zmp_window_max
+        )
         self._fresh_run()
 
     def _fresh_run(self) -> None:

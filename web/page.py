@@ -126,6 +126,22 @@ def _colours(colour: Colour, count: int) -> NDArray[np.uint8]:
     return np.tile(np.array(colour, dtype=np.uint8), (count, 2, 1))
 
 
+def _hidden_arrow(
+    scene: viser.SceneApi, name: str, colour: Colour, sizes: tuple[float, float, float]
+) -> viser.ArrowsHandle:
+    """A hidden arrow ``/world/<name>``; sizes: shaft radius, head radius, head length [m]."""
+    shaft_radius, head_radius, head_length = sizes
+    return scene.add_arrows(
+        f"/world/{name}",
+        np.zeros((1, 2, 3)),
+        colour,
+        shaft_radius=shaft_radius,
+        head_radius=head_radius,
+        head_length=head_length,
+        visible=False,
+    )
+
+
 class PageView:
     """The drawing of a run on a viser server.
 
@@ -237,24 +253,8 @@ class PageView:
                 ("dcm", 0.022, DCM_COLOUR),
             )
         }
-        self.push_node = scene.add_arrows(
-            "/world/push",
-            np.zeros((1, 2, 3)),
-            PUSH_COLOUR,
-            shaft_radius=0.015,
-            head_radius=0.04,
-            head_length=0.08,
-            visible=False,
-        )
-        self.aim_node = scene.add_arrows(
-            "/world/aim",
-            np.zeros((1, 2, 3)),
-            PREVIEW_COLOUR,
-            shaft_radius=0.008,
-            head_radius=0.025,
-            head_length=0.05,
-            visible=False,
-        )
+        self.push_node = _hidden_arrow(scene, "push", PUSH_COLOUR, (0.015, 0.04, 0.08))
+        self.aim_node = _hidden_arrow(scene, "aim", PREVIEW_COLOUR, (0.008, 0.025, 0.05))
         self.fall_label = scene.add_label(
             "/world/fall_label", "", visible=False, font_screen_scale=1.6, anchor="bottom-center"
         )

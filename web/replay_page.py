@@ -9,18 +9,16 @@ Playback stops at the end of the run; Play there starts it again from 0.
 from __future__ import annotations
 
 import html
-import threading
-import time as wallclock
 from pathlib import Path
 from typing import Any
 
 import viser
 
-from app.results.replay import ReplayData
+from app.results.run_files.replay import ReplayData
 
 from .page import PageView
 from .replay_source import snapshot_at
-from .worker import Worker
+from .worker import FrameLoop
 
 FRAME_RATE = 20.0  # [Hz] frames while playing
 SPEEDS = {"0.1x": 0.1, "0.25x": 0.25, "0.5x": 0.5, "1x (real time)": 1.0, "2x": 2.0}
@@ -30,7 +28,7 @@ def _set_value(handle: Any, value: object) -> None:
     handle.value = value
 
 
-class ReplayPage:
+class ReplayPage(FrameLoop):
     """A recorded run on a viser server.
 
     Args:
@@ -52,13 +50,12 @@ class ReplayPage:
         self.server = server
         self.replay = replay
         self.folder = folder
-        self.frame_rate = frame_rate
+        super().__init__(frame_rate, "rsg-replay")
         self.time = 0.0  # [s] replay time shown
         self.playing = False
         self._speed = 1.0
         self._serial = 0
         self._dirty = True
-        self._worker = Worker(self._run, "rsg-replay")
         self.view = PageView(server, urdf, controls=self._build_controls)
 
     def _build_controls(self) -> None:
@@ -92,32 +89,19 @@ class ReplayPage:
         self._speed = SPEEDS[self.speed.value]
         self._dirty = True
 
-    def start(self) -> None:
-        """Start drawing (idempotent)."""
-        self._worker.start()
-
-    def stop(self, timeout: float = 5.0) -> None:
-        """Stop drawing."""
-        self._worker.stop(timeout)
-
-    def _run(self, stop: threading.Event) -> None:
-        period = 1.0 / self.frame_rate
-        last = wallclock.perf_counter()
-        while not stop.is_set():
-            start = wallclock.perf_counter()
-            dt = start - last
-            last = start
-            if self.playing:
-                self.time = min(self.time + dt * self._speed, self.replay.duration)
-                if self.time >= self.replay.duration:
-                    self.playing = False
-                    self.play_button.label = "Play"
-                    self._dirty = True  # draw the end once more, paused
-                _set_value(self.time_slider, round(self.time, 2))
-            if self.playing or self._dirty:
-                self._dirty = False
-                self.show(dt if self.playing else 0.0)
-            stop.wait(max(0.0, period - (wallclock.perf_counter() - start)))
+    def _frame(self, now: float, dt: float) -> bool:
+        """Move the replay time on while playing; draw when it moved or changed."""
+        if self.playing:
+            self.time = min(self.time + dt * self._speed, self.replay.duration)
+            if self.time >= self.replay.duration:
+                self.playing = False
+                self.play_button.label = "Play"
+                self._dirty = True  # draw the end once more, paused
+            _set_value(self.time_slider, round(self.time, 2))
+        if self.playing or self._dirty:
+            self._dirty = False
+            self.show(dt if self.playing else 0.0)
+        return True
 
     def show(self, dt: float = 0.0) -> None:
         """Draw the replay at :attr:`time`."""

@@ -1,4 +1,4 @@
-"""Snapshots of a recorded run (:class:`app.results.replay.ReplayData`) at any time: the replay
+"""Snapshots of a recorded run (:class:`app.results.run_files.replay.ReplayData`) at any time: the replay
 page draws them exactly as the live demo draws its own (:mod:`web.page`).
 
 Pure NumPy: no simulation runs, no viser.
@@ -8,20 +8,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.results.replay import ROBOT_BASE_COLUMNS, STATE_COLUMNS, ReplayData
+from app.results.run_files.replay import ROBOT_BASE_COLUMNS, STATE_COLUMNS, ReplayData
 
 from .scene_model import ControllerState, StepMark
 from .snapshot import (
     DCM_ERROR_TRAIL_TIME,
-    FOOT_MARGIN,
     PLOT_TIME,
+    STEP_MARKS,
     TRAIL_TIME,
     PageStatus,
     RobotPose,
     Snapshot,
+    sole_corners,
 )
 
-STEP_MARKS = 50  # past steps drawn at most
 _COLUMN = {name: index for index, name in enumerate(STATE_COLUMNS)}
 
 
@@ -98,7 +98,7 @@ def snapshot_at(replay: ReplayData, time: float, serial: int = 0, paused: bool =
         ],
     )
     plot = _window(replay, time, PLOT_TIME)
-    margin = np.full(2, FOOT_MARGIN)
+    foot_lower, foot_upper = sole_corners(window_min, window_max)
     return Snapshot(
         serial=serial,
         state=state,
@@ -116,8 +116,8 @@ def snapshot_at(replay: ReplayData, time: float, serial: int = 0, paused: bool =
         plot_lyapunov=replay.state[plot][:, _COLUMN["lyapunov"]],
         plot_time_since_step=replay.state[plot][:, _COLUMN["time_since_step"]],
         level_set=replay.level_set,
-        foot_lower=window_min - margin,
-        foot_upper=window_max + margin,
+        foot_lower=foot_lower,
+        foot_upper=foot_upper,
         mass=float(meta["mass"]),
         pushes_applied=int(np.sum(replay.pushes[:, 0] <= time + 1e-9)),
         adjusted_steps=int(np.sum(taken[:, 4] > 0.5)),

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from .scene_model import ControllerState
 
@@ -21,6 +21,12 @@ TRAIL_TIME = 2.0  # [s] length of the CoM / ZMP / DCM trails
 DCM_ERROR_TRAIL_TIME = 4.0  # [s] length of the e_u trail
 PLOT_TIME = 10.0  # [s] time window of the plots
 FOOT_MARGIN = 0.01  # [m] drawn sole = ZMP window enlarged by this margin
+STEP_MARKS = 50  # past steps kept and drawn at most
+
+
+def sole_corners(window_min: ArrayLike, window_max: ArrayLike) -> tuple[Array, Array]:
+    """The drawn sole's corners [m]: the ZMP window enlarged by :data:`FOOT_MARGIN`."""
+    return np.asarray(window_min, float) - FOOT_MARGIN, np.asarray(window_max, float) + FOOT_MARGIN
 
 
 @dataclass(frozen=True)
