@@ -344,7 +344,7 @@ def run_closed_loop(
             and returns what was simulated, marked ``interrupted``; a second Ctrl-C
             raises KeyboardInterrupt at once. Only in the main thread.
         on_tick: Called after every tick with the loop and the tick's output (e.g. a
-            :class:`app.results.run_files.replay.ReplayRecorder`).
+            :class:`app.results.replay.ReplayRecorder`).
 
     Returns:
         The recorded run. A fall ends the run early; it is never an exception.

@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from app.setup.build.overrides import parse_decimal
+from app.setup.overrides import parse_decimal
 from planner.exceptions import ParameterError
 from planner.parameters import LipmModel, Range
 from planner.types import Push

@@ -8,7 +8,7 @@ import numpy as np
 
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.setup.build.build import build_robot_backend
+from app.setup.build import build_robot_backend
 from planner import Push
 
 backend, config, initial = build_robot_backend("g1", "rsg")  # torque-controlled G1

@@ -29,7 +29,7 @@ Two departures from the paper, both documented in the README:
 D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
 early step the reference may reach D_S sooner, before a real swing foot could land.
 
-Documented extensions, each off under the paper's rules (``app.setup.build.paper_rules.PAPER_RULES``):
+Documented extensions, each off under the paper's rules (``app.setup.paper_rules.PAPER_RULES``):
 ``push_hold_time``, ``step_reaction_time`` (below) and ``qp_at_timing_jump``: H_nu
 takes the QP's step for a timing jump even below gamma_v (a jump from D_T,2 with
 V_u < gamma_v; a decision kept through the reaction time); the paper steps 2 xi1*.
@@ -52,7 +52,7 @@ D_T exactly):
   sees the whole DCM error. ``push_hold_time`` caps the delay for a push that lasts.
   D_T,2 (the CoM past the outer edge of the foot) and D_S are not held. Without a
   push the estimate is zero and nothing changes. Robots in PyBullet keep the
-  paper's D_T (:mod:`app.setup.build.robot_config`): the estimate there is not validated.
+  paper's D_T (:mod:`app.setup.robot_config`): the estimate there is not validated.
 
 Another, for a robot with legs, ``RsgParameters.step_reaction_time`` Delta
 (0, the default, is exactly the paper). The model's jump is instantaneous; a real

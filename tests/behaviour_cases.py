@@ -42,7 +42,7 @@ def run_case(name: str) -> dict[str, np.ndarray]:
     """The case's time series (one array per column) and its steps (as JSON text)."""
     from app.runner import TIMESERIES_COLUMNS, run_closed_loop
     from app.scenarios import Scenario, load_scenario, parse_push
-    from app.setup.build.build import build_backend
+    from app.setup.build import build_backend
 
     model, robot, scenario_name, duration = CASES[name]
     if duration is None:

@@ -12,7 +12,7 @@ from scipy.spatial.transform import Rotation
 from app.backends.pybullet_robot import SimulatedRobot
 from app.runner import ClosedLoop
 from app.scenarios import BUILT_IN
-from app.setup.build.build import build_robot_backend
+from app.setup.build import build_robot_backend
 from app.stabilizer.estimator import StateEstimator
 from kinematics.robot_model import RobotModel
 from robots import get_robot

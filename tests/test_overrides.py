@@ -16,8 +16,8 @@ from app.experiments.grid import GridSpec, run_grid
 from app.experiments.sweep import SweepSpec, run_sweep
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.setup.build.build import build_backend, build_robot_backend, robot_with_overrides
-from app.setup.build.overrides import allowed_names, parse_overrides, parse_value
+from app.setup.build import build_backend, build_robot_backend, robot_with_overrides
+from app.setup.overrides import allowed_names, parse_overrides, parse_value
 from app.stabilizer.config import OPTION_NAMES
 from planner.exceptions import ParameterError
 from planner.types import Push

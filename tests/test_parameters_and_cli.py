@@ -206,9 +206,9 @@ def test_a_robot_run_records_its_physics_model_and_real_time_factor(tmp_path) ->
 
 
 def test_paper_rules_are_one_list_that_the_help_shows(capsys) -> None:
-    """--paper-rules sets every extension of app.setup.build.paper_rules.PAPER_RULES to its paper value,
+    """--paper-rules sets every extension of app.setup.paper_rules.PAPER_RULES to its paper value,
     and each command's help names each of them."""
-    from app.setup.build.paper_rules import PAPER_RULES, paper_rules
+    from app.setup.paper_rules import PAPER_RULES, paper_rules
 
     config = paper_rules(PlannerConfig())
     for extension in PAPER_RULES:

@@ -11,7 +11,7 @@ from app.baselines.placo_wpg import CROSSING_DELAY, PlacoWalkPlanner, humanoid_p
 from app.cli import main
 from app.experiments.sweep import SweepSpec
 from app.runner import walking_start
-from app.setup.build.robot_config import planner_config_for
+from app.setup.robot_config import planner_config_for
 from planner.types import MeasuredState, PlannerOutput, sigma_of
 from robots import get_robot
 

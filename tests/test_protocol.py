@@ -16,7 +16,7 @@ from app.experiments.protocol import DIRECTIONS, GRAVITY, ProtocolSpec, protocol
 from app.experiments.sweep import run_job
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
-from app.setup.build.build import build_backend
+from app.setup.build import build_backend
 from planner.exceptions import ParameterError
 from planner.types import Push
 

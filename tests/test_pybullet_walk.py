@@ -17,7 +17,7 @@ import pytest
 from app.experiments.grid import GridSpec, run_grid
 from app.runner import ClosedLoop, RunResult
 from app.scenarios import BUILT_IN, Scenario
-from app.setup.build.build import build_robot_backend
+from app.setup.build import build_robot_backend
 from planner.types import Push
 
 pytestmark = pytest.mark.slow

@@ -67,9 +67,7 @@ def test_the_short_readme_commands_run_as_written(command, tmp_path):
     elif words[0] == "python":
         words = [sys.executable, str(ROOT / words[1]), *words[2:]]
     env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg"}
-    done = subprocess.run(
-        words, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
-    )
+    done = subprocess.run(words, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr[-2000:]
     if "--out" in words:
         out = tmp_path / words[words.index("--out") + 1]

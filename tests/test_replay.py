@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from app.backends.lipm import LipmBackend
-from app.results.run_files.replay import REPLAY_FILE, ReplayError, ReplayRecorder, load_replay
+from app.results.replay import REPLAY_FILE, ReplayError, ReplayRecorder, load_replay
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import Scenario
 from planner.lyapunov import design_lyapunov

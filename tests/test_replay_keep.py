@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from app.experiments.grid import GridSpec, run_grid
-from app.results.run_files.replay import load_replay
-from app.results.run_files.worst_runs import (
+from app.results.replay import load_replay
+from app.results.worst_runs import (
     format_replays,
     replay_name,
     worst_grid_runs,

@@ -7,7 +7,7 @@ import pytest
 
 from app.runner import walking_start
 from app.scenarios import BUILT_IN, Scenario
-from app.setup.build.paper_rules import paper_rules
+from app.setup.paper_rules import paper_rules
 from conftest import run_lipm, scaled
 from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import PlannerConfig
@@ -313,7 +313,7 @@ def test_paper_rules_give_the_papers_jump_set_on_fig6():
     its end."""
     from app.backends.lipm import LipmBackend
     from app.runner import run_closed_loop
-    from app.setup.build.build import build_backend
+    from app.setup.build import build_backend
 
     _, config, _ = build_backend("lipm", None, "rsg", paper=True)
     assert config.rsg.push_hold_time == 0.0 and config.constraints.com_reach == np.inf

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from app.backends.lipm import LipmBackend
-from app.results.run_files.replay import ReplayData, ReplayRecorder, load_replay
+from app.results.replay import ReplayData, ReplayRecorder, load_replay
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
 from planner.parameters import PlannerConfig

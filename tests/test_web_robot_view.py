@@ -53,7 +53,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
     simulated base, and the drawn stance foot's lowest vertex on the ground."""
     from app.runner import ClosedLoop
     from app.scenarios import Scenario
-    from app.setup.build.build import build_backend
+    from app.setup.build import build_backend
     from planner.types import Push
     from robots.urdf_cache import derived_urdf
     from web.robot_view import RobotView

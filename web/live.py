@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
-from app.setup.build.build import build_backend, resolve_robot
+from app.setup.build import build_backend, resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push

@@ -1,7 +1,7 @@
 """``rsg replay DIR``: serve the page of a recorded run until Ctrl-C.
 
-Loads ``DIR/replay.npz`` (:mod:`app.results.run_files.replay`; a bad folder or file is an
-:class:`app.results.run_files.replay.ReplayError`, printed on one line with exit code 2) and serves
+Loads ``DIR/replay.npz`` (:mod:`app.results.replay`; a bad folder or file is an
+:class:`app.results.replay.ReplayError`, printed on one line with exit code 2) and serves
 :class:`web.replay_page.ReplayPage` (:mod:`web.serve`).
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import viser
 
-from app.results.run_files.replay import load_replay
+from app.results.replay import load_replay
 
 from .serve import check_address, serve
 
@@ -26,7 +26,7 @@ def _robot_urdf(robot: str) -> Path:
 
 def main(args: argparse.Namespace) -> int:
     """Serve the replay of ``args.folder``; returns the exit code (0 after Ctrl-C, 2 on a
-    bad host or port). A bad folder raises :class:`app.results.run_files.replay.ReplayError`."""
+    bad host or port). A bad folder raises :class:`app.results.replay.ReplayError`."""
     replay = load_replay(args.folder)
     refused = check_address("replay", args.host, args.port)
     if refused is not None:

@@ -14,7 +14,7 @@ from typing import Any
 
 import viser
 
-from app.results.run_files.replay import ReplayData
+from app.results.replay import ReplayData
 
 from .page import PageView
 from .replay_source import snapshot_at

@@ -1,4 +1,4 @@
-"""Snapshots of a recorded run (:class:`app.results.run_files.replay.ReplayData`) at any time: the replay
+"""Snapshots of a recorded run (:class:`app.results.replay.ReplayData`) at any time: the replay
 page draws them exactly as the live demo draws its own (:mod:`web.page`).
 
 Pure NumPy: no simulation runs, no viser.
@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.results.run_files.replay import ROBOT_BASE_COLUMNS, STATE_COLUMNS, ReplayData
+from app.results.replay import ROBOT_BASE_COLUMNS, STATE_COLUMNS, ReplayData
 
 from .scene_model import ControllerState, StepMark
 from .snapshot import (

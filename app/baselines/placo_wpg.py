@@ -26,7 +26,7 @@ RSG's :class:`planner.parameters.PlannerConfig`, so both walk the same gait):
 - the footstep frame is the centre of the sole rectangle (placo's support polygon
   is centred on it, and its ZMP target in single support is that centre),
   ``foot_length``/``foot_width`` the sole's size and ``zmp_margin`` the RSG's ZMP
-  margin (:data:`app.setup.build.robot_config.ZMP_MARGIN`); footholds in
+  margin (:data:`app.setup.robot_config.ZMP_MARGIN`); footholds in
   :class:`planner.types.PlannerOutput` are ankle positions o_H, as for the RSG;
 - ``op_space_polygon`` (hard, where the next foot may land relative to the
   stance foot): the RSG's step box u_d^m <= u_d <= u_d^M with the no-crossing
@@ -124,8 +124,8 @@ from numpy.typing import NDArray
 
 from app.backends.base import InitialCondition
 from app.backends.physics_log import PhysicsLog
-from app.setup.build.build import build_robot_backend
-from app.setup.build.overrides import Overrides
+from app.setup.build import build_robot_backend
+from app.setup.overrides import Overrides
 from planner.exceptions import RsgError
 from planner.lyapunov import design_lyapunov
 from planner.parameters import PlannerConfig
@@ -139,7 +139,7 @@ LOCATION_TOLERANCE = 1e-3  # [m] a step further than this from nominal is "adjus
 STEP_TOLERANCE = 0.02  # [m] update_supports moving the next foot less than this: no replan
 TIME_TOLERANCE = 0.01  # [s] ... or moving the end of the support less than this
 CROSSING_DELAY = 0.5 * PLANNING_TIME_STEP  # [s] placo's ZMP crosses between the feet then
-ZMP_MARGIN = 0.005  # [m] same as app.setup.build.robot_config.ZMP_MARGIN
+ZMP_MARGIN = 0.005  # [m] same as app.setup.robot_config.ZMP_MARGIN
 
 
 @dataclass(frozen=True)
@@ -462,7 +462,7 @@ def build_placo_wpg_backend(  # noqa: ANN201
 ):
     """PyBullet backend, configuration, initial condition and planner factory of placo-wpg.
 
-    The backend, IK and configuration are the RSG's (:func:`app.setup.build.build.
+    The backend, IK and configuration are the RSG's (:func:`app.setup.build.
     build_robot_backend`, with ``overrides`` and ``physics_log``); the initial state is
     placo's plan at t = 0.
     """

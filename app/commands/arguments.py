@@ -12,10 +12,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import NoReturn
 
-from app.results.run_files.folder import MAX_PATH_LENGTH
+from app.results.folder import MAX_PATH_LENGTH
 from app.scenarios import MAX_DURATION, parse_push
-from app.setup.build.overrides import MAX_VALUE_LENGTH, parse_decimal
-from app.setup.build.paper_rules import PAPER_RULES_HELP
+from app.setup.overrides import MAX_VALUE_LENGTH, parse_decimal
+from app.setup.paper_rules import PAPER_RULES_HELP
 from planner.exceptions import RsgError
 from planner.types import Push
 

@@ -15,9 +15,9 @@ from app.experiments.bench import (
     format_bench,
     tick_breakdown,
 )
-from app.results.run_files.folder import prepare_out
-from app.setup.build.build import check_robot_overrides
-from app.setup.build.overrides import check_overrides
+from app.results.folder import prepare_out
+from app.setup.build import check_robot_overrides
+from app.setup.overrides import check_overrides
 from planner.exceptions import ParameterError, RsgError
 
 

@@ -19,14 +19,14 @@ from app.commands.arguments import (
 from app.experiments.grid import GridSpec, format_grid, run_grid, write_grid
 from app.experiments.jobs import check_workers
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.results.run_files.folder import prepare_out
-from app.results.run_files.worst_runs import (
+from app.results.folder import prepare_out
+from app.results.worst_runs import (
     add_replays_argument,
     format_replays,
     worst_grid_runs,
     write_worst_replays,
 )
-from app.setup.build.build import check_robot_overrides
+from app.setup.build import check_robot_overrides
 
 EPILOG = """\
 examples:

@@ -13,7 +13,7 @@ from app.commands.arguments import (
 )
 from app.experiments.protocol import ProtocolSpec, format_protocol, run_protocol, write_protocol
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.setup.build.build import check_robot_overrides
+from app.setup.build import check_robot_overrides
 
 EPILOG = """\
 examples:

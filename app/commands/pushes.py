@@ -15,7 +15,7 @@ from app.commands.arguments import (
 from app.experiments.campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
 from app.experiments.campaign_report import format_summary, push_rows, summarize, write_campaign
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.setup.build.build import check_robot_overrides
+from app.setup.build import check_robot_overrides
 from planner.exceptions import RsgError
 
 EPILOG = """\

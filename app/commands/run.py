@@ -17,13 +17,13 @@ from app.commands.arguments import (
     push_argument,
     simulated_seconds,
 )
-from app.results.run_files.folder import prepare_out
-from app.results.run_files.replay import ReplayRecorder
-from app.results.run_files.run_files import write_results
+from app.results.folder import prepare_out
+from app.results.replay import ReplayRecorder
+from app.results.run_files import write_results
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, describe_push, load_scenario
-from app.setup.build.build import build_backend, resolve_robot
-from app.setup.build.overrides import check_overrides
+from app.setup.build import build_backend, resolve_robot
+from app.setup.overrides import check_overrides
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 from planner.types import Push
@@ -144,9 +144,9 @@ def run(args: argparse.Namespace) -> int:
     """Run ``args.scenario``; returns 0 if recovered, 1 if not, 130 if interrupted.
 
     Everything is checked before the backend is built: the scenario and pushes
-    (:mod:`app.scenarios`), the overrides (:func:`app.setup.build.overrides.check_overrides`), that
+    (:mod:`app.scenarios`), the overrides (:func:`app.setup.overrides.check_overrides`), that
     the scenario fits the loop's tick, and the ``--out`` folder
-    (:func:`app.results.run_files.folder.prepare_out`).
+    (:func:`app.results.folder.prepare_out`).
     """
     scenario = load_scenario(args.scenario)
     left_out: list[Push] = []

@@ -17,13 +17,13 @@ from app.experiments.envelope import build_envelope, format_table, write_envelop
 from app.experiments.jobs import check_workers
 from app.experiments.plots import plot_envelope
 from app.experiments.sweep import PLACO_WPG, SweepSpec, run_sweep
-from app.results.run_files.worst_runs import (
+from app.results.worst_runs import (
     add_replays_argument,
     format_replays,
     worst_sweep_runs,
     write_worst_replays,
 )
-from app.setup.build.build import check_robot_overrides
+from app.setup.build import check_robot_overrides
 from planner.parameters import CONTROLLERS
 
 EPILOG = """\

@@ -34,7 +34,7 @@ import numpy as np
 from app.backends.lipm import LipmBackend
 from app.runner import ClosedLoop
 from app.scenarios import BUILT_IN, Scenario
-from app.setup.build.overrides import Overrides
+from app.setup.overrides import Overrides
 from planner.lyapunov import design_lyapunov
 from planner.parameters import PlannerConfig
 from planner.step_generator import ReactiveStepGenerator
@@ -154,7 +154,7 @@ def bench_robot(
 
         backend, config, initial, factory = build_placo_wpg_backend(robot, overrides)
     else:
-        from app.setup.build.build import build_backend
+        from app.setup.build import build_backend
 
         backend, config, initial = build_backend("pybullet", robot, controller, overrides=overrides)
     ik_times: list[float] = []

@@ -48,8 +48,8 @@ from app.experiments.jobs import run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along
 from app.experiments.sweep import PLACO_WPG, check_pushes
 from app.scenarios import MAX_IMPULSE
-from app.setup.build.build import build_backend, resolve_robot
-from app.setup.build.overrides import Overrides, allowed_names
+from app.setup.build import build_backend, resolve_robot
+from app.setup.overrides import Overrides, allowed_names
 from planner.exceptions import ParameterError
 from planner.parameters import LipmModel, PlannerConfig
 from planner.types import Push

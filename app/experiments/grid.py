@@ -31,8 +31,8 @@ from app.experiments.jobs import JobProgress, check_workers, run_in_processes
 from app.experiments.outcome import OUTCOMES, PushRun, describe, impulse_along
 from app.experiments.sweep import check_pushes
 from app.experiments.trial import push_timing
-from app.setup.build.build import resolve_robot
-from app.setup.build.overrides import Overrides
+from app.setup.build import resolve_robot
+from app.setup.overrides import Overrides
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
@@ -45,7 +45,7 @@ class GridSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.setup.build.build.resolve_robot`: ``None`` is G1 on
+        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on
             ``pybullet`` and the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         impulses: Push impulses [N s].
@@ -54,9 +54,9 @@ class GridSpec:
         duration: Push duration [s].
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
-        paper_rules: The paper's rules (:data:`app.setup.build.paper_rules.PAPER_RULES` off).
+        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
-        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.build.overrides`).
+        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
     """
 
     model: str = "pybullet"

@@ -30,7 +30,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any, TypeVar
 
-from app.results.run_files.folder import RESULT_FILES, ResultFolderError, prepare_out
+from app.results.folder import RESULT_FILES, ResultFolderError, prepare_out
 from planner.exceptions import ParameterError, RsgError
 
 T = TypeVar("T")
@@ -232,13 +232,13 @@ def run_resumable(
     a bar labelled ``label`` counting ``unit`` on stderr; ``parse`` reads a line of
     ``jobs.jsonl`` back (default: any JSON object with a ``key``).
 
-    ``label`` is also the command whose files of :data:`app.results.run_files.folder.RESULT_FILES`
+    ``label`` is also the command whose files of :data:`app.results.folder.RESULT_FILES`
     are resumed; ``overwrite`` deletes them (and any other ``rsg`` results) first.
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
         RsgError: The folder cannot be written, or holds files that are not this
-            command's (:func:`app.results.run_files.folder.prepare_out`, :func:`load_finished`).
+            command's (:func:`app.results.folder.prepare_out`, :func:`load_finished`).
     """
     check_workers(workers, backend)
     if backend not in ("process", "ray"):

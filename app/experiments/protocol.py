@@ -45,8 +45,8 @@ from pathlib import Path
 
 from app.experiments.campaign import gait_config, robot_mass
 from app.experiments.sweep import Job, SweepSpec, run_sweep
-from app.setup.build.build import resolve_robot
-from app.setup.build.overrides import Overrides
+from app.setup.build import resolve_robot
+from app.setup.overrides import Overrides
 from planner.exceptions import ParameterError, RsgError
 from planner.parameters import PlannerConfig
 

@@ -36,8 +36,8 @@ from app.experiments.capture_bound import impulse_bound
 from app.experiments.jobs import run_resumable
 from app.experiments.trial import SettledTrial, measured_touchdown, push_timing
 from app.scenarios import Scenario
-from app.setup.build.build import resolve_robot
-from app.setup.build.overrides import Overrides, check_overrides
+from app.setup.build import resolve_robot
+from app.setup.overrides import Overrides, check_overrides
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 from planner.types import Push
@@ -131,7 +131,7 @@ class SweepSpec:
 
     Attributes:
         model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.setup.build.build.resolve_robot`: ``None`` is G1 on ``pybullet`` and
+        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on ``pybullet`` and
             the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         directions: Number of push directions, evenly spaced.
@@ -147,8 +147,8 @@ class SweepSpec:
             backend's own default (0.5 m) is a heuristic below the capturable DCM
             error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
             rule in effect (CoM within 0.6 m of the stance ankle) by default.
-        paper_rules: The paper's rules (:data:`app.setup.build.paper_rules.PAPER_RULES` off).
-        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.build.overrides`).
+        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
+        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
         timing: ``nominal``: the push starts at t_k + phase T^* with t_k the nominal
             touchdown (:func:`app.experiments.trial.push_timing`); ``touchdown``: t_k is
             the touchdown measured in the unpushed walk of each controller and model
@@ -230,7 +230,7 @@ def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN2
 
 
 def _build_rsg(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
-    from app.setup.build.build import build_backend
+    from app.setup.build import build_backend
 
     backend, config, initial = build_backend(
         spec.model, spec.robot, controller, spec.paper_rules, spec.overrides

@@ -106,7 +106,7 @@ def summary_of(result: RunResult, controller: str) -> dict:
 
 def write_results(result: RunResult, controller: str, out_dir: Path, plots: bool = True) -> dict:
     """Write summary.json, timeseries.csv and (optionally, with two ticks or more) PNG
-    plots into ``out_dir`` (checked beforehand by :func:`app.results.run_files.folder.prepare_out`).
+    plots into ``out_dir`` (checked beforehand by :func:`app.results.folder.prepare_out`).
 
     Returns:
         The summary dict.
@@ -129,7 +129,7 @@ def write_results(result: RunResult, controller: str, out_dir: Path, plots: bool
     except OSError as exc:
         raise RsgError(f"cannot write results to {out_dir}: {exc}") from exc
     if plots and len(result.timeseries) >= 2:
-        from app.results.run_files.fig6_plots import plot_fig6
+        from app.results.fig6_plots import plot_fig6
 
         plot_fig6(result, out_dir)
     return summary

@@ -9,7 +9,7 @@ recover is the one to look at; a fall before a mere "not recovered"):
   upper end), for jobs that found one.
 
 Runs are deterministic, so each chosen run is simulated again once with a
-:class:`app.results.run_files.replay.ReplayRecorder` (a few runs, against the hundreds of the sweep)
+:class:`app.results.replay.ReplayRecorder` (a few runs, against the hundreds of the sweep)
 and written to ``OUT/replays/<controller>-<direction>deg-phase<p>-<impulse>Ns/``:
 ``replay.npz`` and ``summary.json``.
 """
@@ -26,8 +26,8 @@ import numpy as np
 
 from app.experiments.sweep import build_controller
 from app.experiments.trial import push_timing
-from app.results.run_files.replay import ReplayRecorder
-from app.results.run_files.run_files import summary_of
+from app.results.replay import ReplayRecorder
+from app.results.run_files import summary_of
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
 from planner.exceptions import RsgError

@@ -8,7 +8,7 @@ from app.backends.base import Backend, InitialCondition
 from app.backends.lipm import LipmBackend
 from app.backends.physics_log import PhysicsLog
 from app.runner import walking_start
-from app.setup.build.overrides import (
+from app.setup.overrides import (
     Overrides,
     ParsedOverrides,
     apply_to_description,
@@ -16,8 +16,8 @@ from app.setup.build.overrides import (
     check_overrides,
     parse_overrides,
 )
-from app.setup.build.paper_rules import paper_rules
-from app.setup.build.robot_config import planner_config_for
+from app.setup.paper_rules import paper_rules
+from app.setup.robot_config import planner_config_for
 from planner.exceptions import ParameterError
 from planner.parameters import PlannerConfig
 from robots import DEFAULT_ROBOT, get_robot
@@ -49,7 +49,7 @@ def build_backend(
             ``lipm`` is its planner configuration (mass, sole, gait, timing) on the
             point mass, what the RSG could do if the robot realised the LIPM exactly.
         paper: The paper's rules (:data:`PAPER_RULES` off, :func:`paper_rules`).
-        overrides: ``--set`` pairs (:mod:`app.setup.build.overrides`); RSG parameters among
+        overrides: ``--set`` pairs (:mod:`app.setup.overrides`); RSG parameters among
             them are applied after ``paper``.
         physics_log: Records every physics step of a ``pybullet`` run (None: nothing).
 
@@ -103,7 +103,7 @@ def build_robot_backend(  # noqa: ANN201
     """PyBullet backend, planner configuration and walking start for ``robot``
     (a registry name or a description), with ``overrides`` (``--set``; RSG
     parameters are applied to the configuration, after the paper's rules when
-    ``paper``, :func:`app.setup.build.paper_rules.paper_rules`). The backend's ``description``
+    ``paper``, :func:`app.setup.paper_rules.paper_rules`). The backend's ``description``
     is the one with the overrides; ``physics_log`` records every physics step.
 
     Raises:

@@ -349,7 +349,7 @@ def _build_settings(
 ) -> RunSettings:
     """Build what a run builds from ``parsed`` (see :func:`check_overrides`)."""
     from app.backends.lipm import CONTROL_PERIOD
-    from app.setup.build.paper_rules import paper_rules
+    from app.setup.paper_rules import paper_rules
     from planner.lyapunov import design_lyapunov
     from planner.parameters import PlannerConfig
 
@@ -357,7 +357,7 @@ def _build_settings(
         config = PlannerConfig(controller=controller)
         period = CONTROL_PERIOD
     else:
-        from app.setup.build.robot_config import planner_config_for
+        from app.setup.robot_config import planner_config_for
 
         description = apply_to_description(robot, parsed)
         config = planner_config_for(description, description.total_mass, controller)
