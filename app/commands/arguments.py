@@ -9,17 +9,21 @@ from __future__ import annotations
 import argparse
 import os
 from collections.abc import Callable
+from dataclasses import fields
 from pathlib import Path
-from typing import NoReturn
+from typing import Any, NoReturn, TypeVar
 
+from app.experiments.jobs import check_workers
 from app.results.folder import MAX_PATH_LENGTH
 from app.scenarios import MAX_DURATION, parse_push
+from app.setup.build import check_robot_overrides
 from app.setup.overrides import MAX_VALUE_LENGTH, parse_decimal
 from app.setup.paper_rules import PAPER_RULES_HELP
 from planner.exceptions import RsgError
 from planner.types import Push
 
 MODELS = ("lipm", "pybullet")
+S = TypeVar("S")
 
 
 class CommandParser(argparse.ArgumentParser):
@@ -28,6 +32,24 @@ class CommandParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
+def add_command(
+    sub: argparse._SubParsersAction, name: str, help: str, description: str, epilog: str = ""
+) -> argparse.ArgumentParser:
+    """Add the command ``name`` to ``sub``; ``epilog`` (examples, outputs) keeps its lines."""
+    return sub.add_parser(  # type: ignore[no-any-return]
+        name,
+        help=help,
+        description=description,
+        epilog=epilog or None,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+
+
+def add_decimal(parser: argparse.ArgumentParser, name: str, default: float, help: str) -> None:
+    """A number option ``name`` (:func:`decimal_argument`); ``help`` gives its unit."""
+    parser.add_argument(name, type=decimal_argument(name), default=default, help=help)
 
 
 def csv_names(text: str) -> tuple[str, ...]:
@@ -207,3 +229,23 @@ def add_job_options(parser: argparse.ArgumentParser) -> None:
 def workers_of(args: argparse.Namespace) -> int:
     """``--workers``, by default the CPU count."""
     return args.workers if args.workers is not None else os.cpu_count() or 1
+
+
+def spec_from_args(kind: type[S], args: argparse.Namespace, **given: Any) -> S:
+    """The specification ``kind`` (a dataclass) from the options of the same names,
+    ``--set`` as its ``overrides``, and ``given``; the other fields keep their defaults."""
+    names = [f.name for f in fields(kind)]  # type: ignore[arg-type]
+    values = {name: getattr(args, name) for name in names if hasattr(args, name)}
+    values["overrides"] = tuple(args.overrides)
+    return kind(**{**values, **given})
+
+
+def job_workers(args: argparse.Namespace, spec: Any) -> int:
+    """The workers of a job command, after checking ``--workers`` and, on the full robot,
+    its ``--set`` (the robot is built once, so a bad value is reported before any worker
+    starts)."""
+    workers = workers_of(args)
+    check_workers(workers, getattr(args, "backend", "process"))
+    if spec.model == "pybullet":
+        check_robot_overrides(spec.robot, spec.overrides)
+    return workers

@@ -5,7 +5,12 @@ from __future__ import annotations
 import argparse
 import json
 
-from app.commands.arguments import add_out_arguments, add_set_argument, decimal_argument
+from app.commands.arguments import (
+    add_command,
+    add_decimal,
+    add_out_arguments,
+    add_set_argument,
+)
 from app.experiments.bench import (
     QP_AGREEMENT,
     bench_placo_wpg,
@@ -20,18 +25,18 @@ from app.setup.build import check_robot_overrides
 from app.setup.overrides import check_overrides
 from planner.exceptions import ParameterError, RsgError
 
+HELP = "time the planner tick, the step QP, IK, physics and the whole loop"
+DESCRIPTION = (
+    "Median and 95th percentile time per call of each part of the loop; "
+    "prints a table and writes bench.json."
+)
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg bench`` to the subcommands."""
-    p = sub.add_parser(
-        "bench",
-        help="time the planner tick, the step QP, IK, physics and the whole loop",
-        description="Median and 95th percentile time per call of each part of the loop; "
-        "prints a table and writes bench.json.",
-    )
+    p = add_command(sub, "bench", HELP, DESCRIPTION)
     p.add_argument("--robot", default="g1", help="robot for the full-robot part (default g1)")
-    p.add_argument("--duration", type=decimal_argument("--duration"), default=4.0,
-                   help="full-robot walk [s] (4)")  # fmt: skip
+    add_decimal(p, "--duration", 4.0, "full-robot walk [s] (4)")
     p.add_argument("--samples", type=int, default=1000, help="sampled step QPs (1000)")
     p.add_argument("--no-robot", action="store_true", help="skip the PyBullet part")
     add_set_argument(p)
@@ -47,9 +52,10 @@ def run(args: argparse.Namespace) -> int:
     overrides = tuple(args.overrides)
     if args.no_robot and overrides:
         raise ParameterError(
-            "--set", " ".join(f"{n}={v}" for n, v in overrides),
+            "--set",
+            " ".join(f"{n}={v}" for n, v in overrides),
             "no --set with --no-robot (the overrides change only the robot's part)",
-        )  # fmt: skip
+        )
     check_overrides(overrides, "pybullet", args.robot)
     if not args.no_robot:
         check_robot_overrides(args.robot, overrides)

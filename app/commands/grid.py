@@ -6,18 +6,19 @@ import argparse
 import time
 
 from app.commands.arguments import (
+    add_command,
     add_controllers,
+    add_decimal,
     add_model_and_robot,
     add_out_arguments,
     add_paper_rules,
     add_set_argument,
     add_workers,
-    decimal_argument,
     decimals_argument,
-    workers_of,
+    job_workers,
+    spec_from_args,
 )
 from app.experiments.grid import GridSpec, format_grid, run_grid, write_grid
-from app.experiments.jobs import check_workers
 from app.experiments.sweep import SWEEP_CONTROLLERS
 from app.results.folder import prepare_out
 from app.results.worst_runs import (
@@ -26,8 +27,13 @@ from app.results.worst_runs import (
     worst_grid_runs,
     write_worst_replays,
 )
-from app.setup.build import check_robot_overrides
 
+HELP = "push grid: every controller against the same fixed pushes, one run each"
+DESCRIPTION = (
+    "Run each controller once per push impulse, direction and phase and "
+    "report recovered / survived / fell: a comparison that, unlike the sweep's "
+    "bisection, does not assume recovery is monotonic in the impulse."
+)
 EPILOG = """\
 examples:
   rsg grid --out results/grid-g1          # G1: rsg, fixed-timing, no-step; 4,6,8,10 N s; 8 dirs
@@ -45,15 +51,7 @@ outputs in --out:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg grid`` to the subcommands."""
-    p = sub.add_parser(
-        "grid",
-        help="push grid: every controller against the same fixed pushes, one run each",
-        description="Run each controller once per push impulse, direction and phase and "
-        "report recovered / survived / fell: a comparison that, unlike the sweep's "
-        "bisection, does not assume recovery is monotonic in the impulse.",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_command(sub, "grid", HELP, DESCRIPTION, EPILOG)
     add_model_and_robot(p, "pybullet")
     add_controllers(p, SWEEP_CONTROLLERS, "rsg,fixed-timing,no-step")
     p.add_argument(
@@ -69,17 +67,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=(0.5625,),
         help="push phases, fractions of the walking cycle (default 0.5625: mid single support)",
     )
-    p.add_argument(
-        "--duration",
-        type=decimal_argument("--duration"),
-        default=0.1,
-        help="push duration [s] (0.1)",
-    )
-    p.add_argument(
+    add_decimal(p, "--duration", 0.1, "push duration [s] (0.1)")
+    add_decimal(
+        p,
         "--settle",
-        type=decimal_argument("--settle"),
-        default=GridSpec.settle,
-        help="time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
+        GridSpec.settle,
+        "time after the push [s] (8: on G1 many runs still standing at 4 s fall later)",
     )
     add_paper_rules(p)
     add_workers(p, backends=False)
@@ -92,22 +85,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``rsg grid``; returns 0."""
-    spec = GridSpec(
-        model=args.model,
-        robot=args.robot,
-        controllers=args.controllers,
-        impulses=args.impulses,
-        directions=args.directions,
-        phases=args.phases,
-        duration=args.duration,
-        settle=args.settle,
-        paper_rules=args.paper_rules,
-        overrides=tuple(args.overrides),
-    )
-    workers = workers_of(args)
-    check_workers(workers)
-    if spec.model == "pybullet":
-        check_robot_overrides(spec.robot, spec.overrides)
+    spec = spec_from_args(GridSpec, args)
+    workers = job_workers(args, spec)
     for path in prepare_out(args.out, "grid", args.overwrite):
         print(f"deleted {path} (--overwrite)")
     started = time.perf_counter()

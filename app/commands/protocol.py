@@ -6,15 +6,25 @@ import argparse
 import time
 
 from app.commands.arguments import (
+    add_command,
     add_controllers,
     add_job_options,
     add_model_and_robot,
-    workers_of,
+    job_workers,
+    spec_from_args,
 )
 from app.experiments.protocol import ProtocolSpec, format_protocol, run_protocol, write_protocol
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.setup.build import check_robot_overrides
 
+HELP = (
+    "IHMC-style pushes forward, backward, inward and outward: largest fraction of "
+    "m g over 0.1 s recovered, beside Atlas's thresholds"
+)
+DESCRIPTION = (
+    "The push-recovery protocol of IHMC's CI tests: a push of f m g for 0.1 s "
+    "at mid swing (forward, backward, inward) or mid double support (outward); bisect "
+    "the largest f recovered per direction and compare with IHMC's Atlas thresholds."
+)
 EPILOG = """\
 examples:
   rsg protocol --model lipm --out results/protocol-lipm                  # the paper's point mass
@@ -36,16 +46,7 @@ outputs in --out:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg protocol`` to the subcommands."""
-    p = sub.add_parser(
-        "protocol",
-        help="IHMC-style pushes forward, backward, inward and outward: largest fraction of "
-        "m g over 0.1 s recovered, beside Atlas's thresholds",
-        description="The push-recovery protocol of IHMC's CI tests: a push of f m g for 0.1 s "
-        "at mid swing (forward, backward, inward) or mid double support (outward); bisect "
-        "the largest f recovered per direction and compare with IHMC's Atlas thresholds.",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_command(sub, "protocol", HELP, DESCRIPTION, EPILOG)
     add_model_and_robot(p, "lipm")
     add_controllers(p, SWEEP_CONTROLLERS, "rsg")
     p.add_argument("--tolerance", type=float, default=0.01, help="bisection tolerance on f (0.01)")
@@ -61,19 +62,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``rsg protocol``; returns 0."""
-    spec = ProtocolSpec(
-        model=args.model,
-        robot=args.robot,
-        controllers=args.controllers,
-        settle=args.settle,
-        tolerance=args.tolerance,
-        criterion=args.criterion,
-        paper_rules=args.paper_rules,
-        overrides=tuple(args.overrides),
-    )
-    if spec.model == "pybullet":
-        check_robot_overrides(spec.robot, spec.overrides)
-    workers = workers_of(args)
+    spec = spec_from_args(ProtocolSpec, args)
+    workers = job_workers(args, spec)
     started = time.perf_counter()
     document = run_protocol(
         spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite

@@ -6,18 +6,26 @@ import argparse
 import time
 
 from app.commands.arguments import (
+    add_command,
     add_controllers,
     add_job_options,
     add_model_and_robot,
     decimals_argument,
-    workers_of,
+    job_workers,
+    spec_from_args,
 )
 from app.experiments.campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
 from app.experiments.campaign_report import format_summary, push_rows, summarize, write_campaign
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.setup.build import check_robot_overrides
 from planner.exceptions import RsgError
 
+HELP = "push campaign: random pushes over a whole gait cycle, each beside its LIPM twin"
+DESCRIPTION = (
+    "Draw N random pushes from a seed (direction uniform, start time uniform "
+    "over one gait cycle after a settled walk, impulse and duration uniform in ranges), run "
+    "each with every controller and on the LIPM with the same robot's planner (the twin), "
+    "and report recovered / survived / fell, adjusted steps and steps to settle."
+)
 EPILOG = """\
 examples:
   rsg pushes --seed dev --out results/pushes-g1-dev          # G1: 100 pushes, rsg and no-step
@@ -45,16 +53,7 @@ def _seed(text: str) -> int:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg pushes`` to the subcommands."""
-    p = sub.add_parser(
-        "pushes",
-        help="push campaign: random pushes over a whole gait cycle, each beside its LIPM twin",
-        description="Draw N random pushes from a seed (direction uniform, start time uniform "
-        "over one gait cycle after a settled walk, impulse and duration uniform in ranges), run "
-        "each with every controller and on the LIPM with the same robot's planner (the twin), "
-        "and report recovered / survived / fell, adjusted steps and steps to settle.",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_command(sub, "pushes", HELP, DESCRIPTION, EPILOG)
     add_model_and_robot(p, "pybullet")
     add_controllers(p, SWEEP_CONTROLLERS, "rsg,no-step")
     p.add_argument(
@@ -99,22 +98,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Run ``rsg pushes``; returns 0."""
-    spec = CampaignSpec(
-        model=args.model,
-        robot=args.robot,
-        controllers=args.controllers,
-        pushes=args.pushes,
-        seed=args.seed,
-        impulse=args.impulse,
-        duration=args.duration,
-        cycle=args.cycle,
-        settle=args.settle,
-        paper_rules=args.paper_rules,
-        overrides=tuple(args.overrides),
-    )
-    if spec.model == "pybullet":
-        check_robot_overrides(spec.robot, spec.overrides)
-    workers = workers_of(args)
+    spec = spec_from_args(CampaignSpec, args)
+    workers = job_workers(args, spec)
     started = time.perf_counter()
     pushes, records = run_campaign(
         spec, args.out, workers, args.backend, not args.quiet, args.overwrite

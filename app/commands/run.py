@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from app.commands.arguments import (
+    add_command,
     add_model_and_robot,
     add_out_arguments,
     add_paper_rules,
@@ -51,6 +52,11 @@ class ProgressBar:
             sys.stderr.flush()
 
 
+HELP = "simulate one scenario headless and write summary, time series and plots"
+DESCRIPTION = (
+    "Simulate one scenario with a step controller in the loop, headless, and "
+    "write summary.json, timeseries.csv and the paper's Fig. 6 plots to --out."
+)
 EPILOG = """\
 examples:
   rsg run --scenario walk --duration 20 --out results/g1-walk       # G1 in PyBullet
@@ -91,14 +97,7 @@ def verdict(result: RunResult) -> str:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg run`` to the subcommands."""
-    p = sub.add_parser(
-        "run",
-        help="simulate one scenario headless and write summary, time series and plots",
-        description="Simulate one scenario with a step controller in the loop, headless, and "
-        "write summary.json, timeseries.csv and the paper's Fig. 6 plots to --out.",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_command(sub, "run", HELP, DESCRIPTION, EPILOG)
     add_model_and_robot(p, "pybullet")
     p.add_argument(
         "--controller",

@@ -6,15 +6,16 @@ import argparse
 import time
 
 from app.commands.arguments import (
+    add_command,
+    add_decimal,
     add_job_options,
     add_model_and_robot,
     csv_names,
-    decimal_argument,
     decimals_argument,
-    workers_of,
+    job_workers,
+    spec_from_args,
 )
 from app.experiments.envelope import build_envelope, format_table, write_envelope
-from app.experiments.jobs import check_workers
 from app.experiments.plots import plot_envelope
 from app.experiments.sweep import PLACO_WPG, SweepSpec, run_sweep
 from app.results.worst_runs import (
@@ -23,9 +24,14 @@ from app.results.worst_runs import (
     worst_sweep_runs,
     write_worst_replays,
 )
-from app.setup.build import check_robot_overrides
 from planner.parameters import CONTROLLERS
 
+HELP = "robustness map: largest recovered impulse per controller, direction and phase"
+DESCRIPTION = (
+    "Bisect, for each controller, push direction and push phase, the largest "
+    "impulse that is still recovered, next to the capture bound (an upper limit for any "
+    "controller on the LIPM)."
+)
 EPILOG = """\
 examples:
   rsg sweep --model lipm --directions 16 --out results/sweep
@@ -48,15 +54,7 @@ outputs in --out:
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg sweep`` to the subcommands."""
-    p = sub.add_parser(
-        "sweep",
-        help="robustness map: largest recovered impulse per controller, direction and phase",
-        description="Bisect, for each controller, push direction and push phase, the largest "
-        "impulse that is still recovered, next to the capture bound (an upper limit for any "
-        "controller on the LIPM).",
-        epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+    p = add_command(sub, "sweep", HELP, DESCRIPTION, EPILOG)
     add_model_and_robot(p, "lipm")
     p.add_argument(
         "--controllers",
@@ -72,25 +70,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         default=(0.0, 0.25, 0.5, 0.75),
         help="push phases, fractions of the walking cycle (default 0,0.25,0.5,0.75)",
     )
-    p.add_argument(
-        "--duration",
-        type=decimal_argument("--duration"),
-        default=0.1,
-        help="push duration [s] (0.1)",
-    )
+    add_decimal(p, "--duration", 0.1, "push duration [s] (0.1)")
     p.add_argument("--cycle", type=int, default=3, help="walking cycle of the push (3)")
-    p.add_argument(
-        "--settle",
-        type=decimal_argument("--settle"),
-        default=6.0,
-        help="time after the push [s] (6)",
-    )
-    p.add_argument(
-        "--tolerance",
-        type=decimal_argument("--tolerance"),
-        default=0.25,
-        help="bisection [N s] (0.25)",
-    )
+    add_decimal(p, "--settle", 6.0, "time after the push [s] (6)")
+    add_decimal(p, "--tolerance", 0.25, "bisection [N s] (0.25)")
     p.add_argument(
         "--criterion",
         choices=("recovered", "no-fall"),
@@ -114,24 +97,8 @@ def run(args: argparse.Namespace) -> int:
         with_wpg = args.model == "pybullet"
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
     criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
-    spec = SweepSpec(
-        model=args.model,
-        robot=args.robot,
-        controllers=tuple(controllers),
-        directions=args.directions,
-        phases=args.phases,
-        duration=args.duration,
-        cycle=args.cycle,
-        settle=args.settle,
-        tolerance=args.tolerance,
-        criterion=criterion,
-        paper_rules=args.paper_rules,
-        overrides=tuple(args.overrides),
-    )
-    workers = workers_of(args)
-    check_workers(workers, args.backend)
-    if spec.model == "pybullet":
-        check_robot_overrides(spec.robot, spec.overrides)
+    spec = spec_from_args(SweepSpec, args, controllers=tuple(controllers), criterion=criterion)
+    workers = job_workers(args, spec)
     started = time.perf_counter()
     records = run_sweep(
         spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite
