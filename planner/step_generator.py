@@ -1,5 +1,8 @@
 """The reactive step generator: the hybrid tracking controller (17) of Section V-B.
 
+Why one long module: the flow, the jump sets and the output map all read and write
+the controller's state nu; split, each part would reach into the others' state.
+
 State nu = (zeta, o_H, r_H^dagger, s~, V_u^dagger):
 
 - flow  F_nu = ((u^_c* - zeta) / theta, 0, 0, 1, 0),

@@ -1,5 +1,8 @@
 """The live simulation of the browser demo: the closed loop in its own thread.
 
+Why one long module: the thread, the requests it applies and the snapshots it
+publishes share the loop, which only the thread touches.
+
 :class:`LiveSimulation` advances :class:`app.runner.ClosedLoop` at real time (times
 the slow-motion factor) when the machine allows, and as fast as it can otherwise;
 the measured speed is reported in the status. The page never touches the loop: it

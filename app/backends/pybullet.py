@@ -126,10 +126,6 @@ class PyBulletBackend:
         """The planner's step timing used by the swing foot."""
         return self.controller.timing
 
-    @timing.setter
-    def timing(self, value: SwingTiming) -> None:
-        self.controller.timing = value
-
     # ------------------------------------------------------------------ reset
     def reset(self, initial: InitialCondition) -> MeasuredState:
         """Stand on both feet at the initial footholds with the initial CoM state."""

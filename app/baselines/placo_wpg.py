@@ -1,5 +1,8 @@
 """The ``placo-wpg`` baseline: placo's walk pattern generator with ``update_supports``.
 
+Why one long module: placo's generator, its re-planning and the adapter to the RSG's
+interface share one plan; the baseline is one concept.
+
 The baseline a placo user would pick (placo 0.10.2), driving the same robot through
 the same whole-body IK (:class:`kinematics.whole_body_ik.WholeBodyIK`) and the same
 PyBullet backend as the RSG. :class:`PlacoWalkPlanner` has the generator's

@@ -2,6 +2,9 @@
 refined by branch and bound (the model and its limits: :mod:`app.experiments.capturability`; the
 derivation: ``docs/bound.md``).
 
+Why one long module: the relaxation and its branch and bound share the programme's
+construction (``_Programme``).
+
 A node is a tuple of windows [a_k, b_k] holding the times tau_k of the first steps after
 the push start; the last may be open, [a, inf): that step, and all later ones, come at a
 or later, or never. For a node one linear programme maximises the impulse over what a

@@ -1,7 +1,9 @@
 """``--set NAME=VALUE``: change one parameter of a run, a push grid or a sweep.
 
-Every tuning choice recorded in ``robots/g1.py`` (T_SP, the reaction time, the CoP
-loops, the swing's descent slope, ...) can be measured again from the command line,
+Why one long module: parsing, ranges and error wording of one option language.
+
+Every tuning choice of a robot description (T_SP, the reaction time, the landing
+depth, the flywheel, ...) can be measured again from the command line,
 for example ``rsg grid --set swing_preparation_time=0.3 --controllers rsg --out DIR``.
 A name is looked up in this order:
 

@@ -104,12 +104,8 @@ class WholeBodyController:
 
     @property
     def timing(self) -> SwingTiming:
+        """The planner's step timing used by the swing foot."""
         return self.swing.timing
-
-    @timing.setter
-    def timing(self, value: SwingTiming) -> None:
-        self.swing.timing = value
-        self.landing.double_support = value.double_support
 
     def _reset_state(self, com_xy: NDArray[np.float64]) -> None:
         self._stance: Foot = "left"
