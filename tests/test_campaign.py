@@ -27,6 +27,7 @@ from app.experiments.campaign import (
     touchdowns,
 )
 from app.experiments.campaign_report import push_argument, push_rows, summarize
+from app.experiments.jobs import JobRun
 from app.experiments.outcome import PushRun
 from planner.exceptions import ParameterError
 from robots import get_robot
@@ -166,21 +167,21 @@ def test_interrupted_campaign_resumes_and_skips_finished_runs(tmp_path: Path, mo
 
     monkeypatch.setattr(campaign_module, "run_campaign_job", counting)
     with pytest.raises(KeyboardInterrupt):
-        run_campaign(spec, tmp_path, workers=1, progress=False)
+        run_campaign(spec, JobRun(tmp_path, workers=1, progress=False))
     assert len((tmp_path / "jobs.jsonl").read_text().splitlines()) == 2
     calls.clear()
-    pushes, records = run_campaign(spec, tmp_path, workers=1, progress=False)
+    pushes, records = run_campaign(spec, JobRun(tmp_path, workers=1, progress=False))
     assert len(calls) == 2  # the two runs not finished before
     calls.clear()
-    run_campaign(spec, tmp_path, workers=1, progress=False)
+    run_campaign(spec, JobRun(tmp_path, workers=1, progress=False))
     assert calls == []  # all finished: nothing runs again
     more = replace(spec, pushes=3)
-    _, extended = run_campaign(more, tmp_path, workers=1, progress=False)
+    _, extended = run_campaign(more, JobRun(tmp_path, workers=1, progress=False))
     assert sorted(calls) == ["2|no-step|robot", "2|rsg|robot"]
     assert all(extended[key] == record for key, record in records.items())
     for change in ({"seed": 2}, {"impulse": (20.0, 41.0)}, {"settle": 4.0}):
         with pytest.raises(ParameterError) as error:
-            run_campaign(replace(spec, **change), tmp_path, workers=1, progress=False)
+            run_campaign(replace(spec, **change), JobRun(tmp_path, workers=1, progress=False))
         assert "new --out folder" in str(error.value)
 
 
@@ -252,10 +253,12 @@ def test_ray_backend_gives_the_same_campaign(tmp_path: Path) -> None:
     ray = pytest.importorskip("ray", reason="ray is not installed (pip install 'rsg[ray]')")
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
-        _, on_ray = run_campaign(QUICK, tmp_path / "ray", workers=2, backend="ray", progress=False)
+        _, on_ray = run_campaign(
+            QUICK, JobRun(tmp_path / "ray", workers=2, backend="ray", progress=False)
+        )
     finally:
         ray.shutdown()
-    _, local = run_campaign(QUICK, tmp_path / "local", workers=1, progress=False)
+    _, local = run_campaign(QUICK, JobRun(tmp_path / "local", workers=1, progress=False))
     assert on_ray.keys() == local.keys()
     for key, record in local.items():
         for figure in ("outcome", "adjusted_steps", "settle_steps", "end_time", "final_lyapunov"):
@@ -266,7 +269,7 @@ def test_ray_backend_gives_the_same_campaign(tmp_path: Path) -> None:
 def test_small_g1_campaign(tmp_path: Path) -> None:
     """Two pushes on G1 in PyBullet with rsg and their twins, in two workers."""
     spec = CampaignSpec(controllers=("rsg",), pushes=2)
-    pushes, records = run_campaign(spec, tmp_path, workers=2, progress=False)
+    pushes, records = run_campaign(spec, JobRun(tmp_path, workers=2, progress=False))
     rows = push_rows(spec, pushes, records)
     assert len(rows) == 2
     for row in rows:

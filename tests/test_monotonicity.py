@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 from app.cli import main
+from app.experiments.jobs import JobRun
 from app.experiments.monotonicity import FRACTIONS, run_monotonicity
 from app.experiments.sweep import SweepSpec
 from app.experiments.trial import push_timing
@@ -34,7 +35,7 @@ def test_a_push_weaker_than_one_reported_recovered_that_falls_is_counted(tmp_pat
     start = push_timing(PlannerConfig(), spec.cycle, 0.5)[0]
     claimed = {"key": "rsg|0|0.5", "controller": "rsg", "direction_deg": 0.0, "phase": 0.5,
                "push_time": start, "impulse": 600.0}  # fmt: skip
-    report = run_monotonicity(spec, [claimed], tmp_path, workers=1, progress=False)
+    report = run_monotonicity(spec, [claimed], JobRun(tmp_path, workers=1, progress=False))
     part = report["controllers"]["rsg"]
     assert part["per_fraction"] == {"0.25": 0, "0.5": 1, "0.75": 1}
     assert part["not_passed"] == 2

@@ -13,6 +13,7 @@ import pytest
 from app.cli import main
 from app.commands.arguments import parse_assignment
 from app.experiments.grid import GridSpec, run_grid
+from app.experiments.jobs import JobRun
 from app.experiments.sweep import SweepSpec, run_sweep
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
@@ -190,11 +191,11 @@ def test_a_resumed_sweep_must_have_the_same_overrides(tmp_path: Path) -> None:
         controllers=("no-step",), directions=1, phases=(0.0,), tolerance=5.0,
         overrides=(("crossing_margin", "0.05"),),
     )  # fmt: skip
-    run_sweep(spec, tmp_path, workers=1, progress=False)
-    run_sweep(spec, tmp_path, workers=1, progress=False)  # resumes: nothing left to do
+    run_sweep(spec, JobRun(tmp_path, workers=1, progress=False))
+    run_sweep(spec, JobRun(tmp_path, workers=1, progress=False))  # resumes: nothing left to do
     other = SweepSpec(**{**spec.__dict__, "overrides": (("crossing_margin", "0.04"),)})
     with pytest.raises(ParameterError) as error:
-        run_sweep(other, tmp_path, workers=1, progress=False)
+        run_sweep(other, JobRun(tmp_path, workers=1, progress=False))
     assert "overrides" in error.value.field
     assert error.value.value == (("crossing_margin", "0.04"),)  # what was given
     assert "0.05" in error.value.allowed  # what the folder holds

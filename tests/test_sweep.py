@@ -13,6 +13,7 @@ import pytest
 import app.experiments.sweep as sweep_module
 from app.experiments.bisection import bisect_threshold
 from app.experiments.envelope import build_envelope, format_table, write_envelope
+from app.experiments.jobs import JobRun
 from app.experiments.plots import plot_envelope
 from app.experiments.sweep import Job, SweepSpec, _build, run_sweep
 from app.experiments.trial import SettledTrial, push_timing
@@ -94,7 +95,7 @@ TINY = SweepSpec(controllers=("rsg", "no-step"), directions=2, phases=(0.5,), to
 
 
 def test_interrupted_sweep_resumes_to_the_same_envelope(tmp_path: Path, monkeypatch) -> None:
-    reference = run_sweep(TINY, tmp_path / "whole", workers=1, progress=False)
+    reference = run_sweep(TINY, JobRun(tmp_path / "whole", workers=1, progress=False))
     real = sweep_module.run_job
     calls = {"n": 0}
 
@@ -106,13 +107,13 @@ def test_interrupted_sweep_resumes_to_the_same_envelope(tmp_path: Path, monkeypa
 
     monkeypatch.setattr(sweep_module, "run_job", interrupted)
     with pytest.raises(KeyboardInterrupt):
-        run_sweep(TINY, tmp_path / "cut", workers=1, progress=False)
+        run_sweep(TINY, JobRun(tmp_path / "cut", workers=1, progress=False))
     kept = (tmp_path / "cut" / "jobs.jsonl").read_text().splitlines()
     assert len(kept) == 2
     with (tmp_path / "cut" / "jobs.jsonl").open("a") as sink:
         sink.write('{"key": "half a line')  # a record cut by the interruption
     monkeypatch.setattr(sweep_module, "run_job", real)
-    resumed = run_sweep(TINY, tmp_path / "cut", workers=2, progress=False)
+    resumed = run_sweep(TINY, JobRun(tmp_path / "cut", workers=2, progress=False))
     assert [r["key"] for r in resumed] == [r["key"] for r in reference]
     assert [r["impulse"] for r in resumed] == [r["impulse"] for r in reference]
     assert (
@@ -120,7 +121,7 @@ def test_interrupted_sweep_resumes_to_the_same_envelope(tmp_path: Path, monkeypa
         == build_envelope(TINY, reference)["controllers"]
     )
     with pytest.raises(ParameterError):
-        run_sweep(SweepSpec(**{**TINY.__dict__, "tolerance": 1.0}), tmp_path / "cut", 1)
+        run_sweep(SweepSpec(**{**TINY.__dict__, "tolerance": 1.0}), JobRun(tmp_path / "cut", 1))
 
 
 LIPM_SWEEP = SweepSpec(directions=8, phases=(0.0, 0.5), tolerance=0.5)
@@ -133,7 +134,7 @@ def lipm_envelope(tmp_path_factory: pytest.TempPathFactory) -> dict:
     push end of the bound matter there)."""
     out = tmp_path_factory.mktemp("sweep")
     workers = int(os.environ.get("RSG_TEST_WORKERS", "2"))
-    records = run_sweep(LIPM_SWEEP, out, workers=workers, progress=False)
+    records = run_sweep(LIPM_SWEEP, JobRun(out, workers=workers, progress=False))
     envelope = build_envelope(LIPM_SWEEP, records)
     paths = write_envelope(out, envelope)
     paths.append(plot_envelope(envelope, out / "envelope.png"))
@@ -178,10 +179,10 @@ def test_ray_backend_gives_the_same_envelope(tmp_path: Path) -> None:
     spec = SweepSpec(controllers=("no-step",), directions=2, phases=(0.25,), tolerance=8.0)
     ray.init(num_cpus=2, include_dashboard=False, log_to_driver=False)
     try:
-        on_ray = run_sweep(spec, tmp_path / "ray", workers=2, backend="ray", progress=False)
+        on_ray = run_sweep(spec, JobRun(tmp_path / "ray", workers=2, backend="ray", progress=False))
     finally:
         ray.shutdown()
-    local = run_sweep(spec, tmp_path / "local", workers=1, progress=False)
+    local = run_sweep(spec, JobRun(tmp_path / "local", workers=1, progress=False))
     assert [r["impulse"] for r in on_ray] == [r["impulse"] for r in local]
 
 
@@ -196,7 +197,7 @@ def test_full_robot_sweep_compares_the_controllers_forward(tmp_path: Path) -> No
         model="pybullet", controllers=("rsg", "no-step", "placo-wpg"), directions=1,
         phases=(0.5625,), tolerance=4.0, settle=4.0, criterion="no-fall",
     )  # fmt: skip
-    records = run_sweep(spec, tmp_path, workers=2, progress=False)
+    records = run_sweep(spec, JobRun(tmp_path, workers=2, progress=False))
     impulse: dict[str, float] = {}
     for record in records:
         assert record["bound"] > 0.0 and 0.0 <= record["impulse"] <= 1.1 * record["bound"]

@@ -13,7 +13,7 @@ from dataclasses import fields
 from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
-from app.experiments.jobs import check_workers
+from app.experiments.jobs import JobRun, check_workers
 from app.results.folder import MAX_PATH_LENGTH
 from app.scenarios import MAX_DURATION, parse_push
 from app.setup.build import check_robot_overrides
@@ -249,3 +249,10 @@ def job_workers(args: argparse.Namespace, spec: Any) -> int:
     if spec.model == "pybullet":
         check_robot_overrides(spec.robot, spec.overrides)
     return workers
+
+
+def job_run(args: argparse.Namespace, spec: Any) -> JobRun:
+    """Where and how the jobs of ``spec`` run (``--out``, ``--workers``, ``--backend``,
+    ``--quiet``, ``--overwrite``), after :func:`job_workers`' checks."""
+    workers = job_workers(args, spec)
+    return JobRun(args.out, workers, args.backend, not args.quiet, args.overwrite)

@@ -10,7 +10,7 @@ from app.commands.arguments import (
     add_controllers,
     add_job_options,
     add_model_and_robot,
-    job_workers,
+    job_run,
     spec_from_args,
 )
 from app.experiments.protocol import ProtocolSpec, format_protocol, run_protocol, write_protocol
@@ -63,11 +63,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``rsg protocol``; returns 0."""
     spec = spec_from_args(ProtocolSpec, args)
-    workers = job_workers(args, spec)
+    run_as = job_run(args, spec)
     started = time.perf_counter()
-    document = run_protocol(
-        spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite
-    )
+    document = run_protocol(spec, run_as)
     document["wall_time"] = time.perf_counter() - started
     for path in write_protocol(args.out, document):
         print(f"wrote {path}")

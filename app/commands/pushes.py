@@ -11,7 +11,7 @@ from app.commands.arguments import (
     add_job_options,
     add_model_and_robot,
     decimals_argument,
-    job_workers,
+    job_run,
     spec_from_args,
 )
 from app.experiments.campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
@@ -99,11 +99,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``rsg pushes``; returns 0."""
     spec = spec_from_args(CampaignSpec, args)
-    workers = job_workers(args, spec)
+    run_as = job_run(args, spec)
     started = time.perf_counter()
-    pushes, records = run_campaign(
-        spec, args.out, workers, args.backend, not args.quiet, args.overwrite
-    )
+    pushes, records = run_campaign(spec, run_as)
     wall_time = time.perf_counter() - started
     rows = push_rows(spec, pushes, records)
     summary = summarize(spec, rows)

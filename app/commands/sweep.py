@@ -12,7 +12,7 @@ from app.commands.arguments import (
     add_model_and_robot,
     csv_names,
     decimals_argument,
-    job_workers,
+    job_run,
     spec_from_args,
 )
 from app.experiments.envelope import build_envelope, format_table, write_envelope
@@ -98,11 +98,9 @@ def run(args: argparse.Namespace) -> int:
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
     criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
     spec = spec_from_args(SweepSpec, args, controllers=tuple(controllers), criterion=criterion)
-    workers = job_workers(args, spec)
+    run_as = job_run(args, spec)
     started = time.perf_counter()
-    records = run_sweep(
-        spec, args.out, workers, args.backend, progress=not args.quiet, overwrite=args.overwrite
-    )
+    records = run_sweep(spec, run_as)
     envelope = build_envelope(spec, records)
     worst = worst_sweep_runs(records, args.replays)
     if worst and not args.quiet:
@@ -123,9 +121,7 @@ def run(args: argparse.Namespace) -> int:
             write_monotonicity,
         )
 
-        report = run_monotonicity(
-            spec, records, args.out, workers, args.backend, not args.quiet, args.overwrite
-        )
+        report = run_monotonicity(spec, records, run_as)
         print(f"wrote {write_monotonicity(args.out, report)}")
         print(format_monotonicity(report))
     return 0

@@ -40,11 +40,10 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass, replace
-from pathlib import Path
 
 import numpy as np
 
-from app.experiments.jobs import run_resumable
+from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along
 from app.experiments.sweep import PLACO_WPG, check_pushes
 from app.scenarios import MAX_IMPULSE
@@ -311,15 +310,8 @@ def _run_campaign_job_args(args: tuple[CampaignSpec, CampaignPush, CampaignJob, 
     return run_campaign_job(*args)
 
 
-def run_campaign(
-    spec: CampaignSpec,
-    out: Path,
-    workers: int = 1,
-    backend: str = "process",
-    progress: bool = True,
-    overwrite: bool = False,
-) -> tuple[list[CampaignPush], dict[str, dict]]:
-    """Run (or resume) the campaign into ``out``; returns the pushes and the record
+def run_campaign(spec: CampaignSpec, run: JobRun) -> tuple[list[CampaignPush], dict[str, dict]]:
+    """Run (or resume) the campaign as ``run`` says; returns the pushes and the record
     of every run by its key.
 
     Raises:
@@ -331,7 +323,7 @@ def run_campaign(
     arguments = {
         job.key: (spec, pushes[job.index], job, times[job.model_key]) for job in campaign_jobs(spec)
     }
-    records = run_resumable(_run_campaign_job_args, arguments, out, spec, RESULT_FIELDS,
-                            SPEC_FILE, workers, backend, progress, "pushes", "runs",
-                            overwrite=overwrite)  # fmt: skip
+    records = run_resumable(
+        _run_campaign_job_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, run, "pushes", "runs"
+    )
     return pushes, records

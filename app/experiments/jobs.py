@@ -26,7 +26,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -210,41 +210,58 @@ def parse_keyed(line: bytes) -> tuple[dict | None, str]:
     return record, ""
 
 
+@dataclass(frozen=True)
+class JobRun:
+    """Where and how a command's jobs run.
+
+    Attributes:
+        out: The results folder; it holds ``jobs.jsonl`` and the specification, so the
+            same command on it resumes.
+        workers: Parallel workers, at most :func:`max_workers`.
+        backend: ``process`` (worker processes) or ``ray`` (a Ray cluster).
+        progress: A progress bar on stderr.
+        overwrite: Delete the folder's earlier ``rsg`` results first.
+    """
+
+    out: Path
+    workers: int = 1
+    backend: str = "process"
+    progress: bool = True
+    overwrite: bool = False
+
+
 def run_resumable(
     function: Callable[[T], dict],
     arguments: dict[str, T],
-    out: Path,
     spec: Any,
     fields: tuple[str, ...],
     spec_file: str,
-    workers: int,
-    backend: str,
-    progress: bool,
+    run: JobRun,
     label: str = "sweep",
     unit: str = "jobs",
-    overwrite: bool = False,
     parse: Callable[[bytes], tuple[dict | None, str]] = parse_keyed,
 ) -> dict[str, dict]:
     """The records of ``function`` over ``arguments`` (key -> argument; each record
-    carries its ``key``), run in ``workers`` or taken from ``out``'s ``jobs.jsonl``:
+    carries its ``key``), run as ``run`` says or taken from its folder's ``jobs.jsonl``:
     each new record is appended there as soon as it is done, and ``spec`` is stored in
-    ``spec_file`` (:func:`load_finished` checks ``fields`` on a resume). ``progress``:
-    a bar labelled ``label`` counting ``unit`` on stderr; ``parse`` reads a line of
+    ``spec_file`` (:func:`load_finished` checks ``fields`` on a resume). The progress
+    bar is labelled ``label`` and counts ``unit``; ``parse`` reads a line of
     ``jobs.jsonl`` back (default: any JSON object with a ``key``).
 
     ``label`` is also the command whose files of :data:`app.results.folder.RESULT_FILES`
-    are resumed; ``overwrite`` deletes them (and any other ``rsg`` results) first.
+    are resumed; ``run.overwrite`` deletes them (and any other ``rsg`` results) first.
 
     Raises:
         ParameterError: Bad workers/backend or a mismatching folder.
         RsgError: The folder cannot be written, or holds files that are not this
             command's (:func:`app.results.folder.prepare_out`, :func:`load_finished`).
     """
+    out, workers, backend, progress = run.out, run.workers, run.backend, run.progress
     check_workers(workers, backend)
     if backend not in ("process", "ray"):
         raise ParameterError("--backend", backend, "process or ray")
-    own = () if overwrite else RESULT_FILES[label]
-    for path in prepare_out(out, label, overwrite, resumable=own):
+    own = () if run.overwrite else RESULT_FILES[label]
+    for path in prepare_out(out, label, run.overwrite, resumable=own):
         if progress:
             print(f"deleted {path} (--overwrite)", file=sys.stderr)
     try:

@@ -17,9 +17,10 @@ from __future__ import annotations
 import json
 import math
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from app.experiments.jobs import run_resumable
+from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along
 from app.experiments.sweep import RESULT_FIELDS, SPEC_FILE, SweepSpec
 from planner.exceptions import RsgError
@@ -61,16 +62,8 @@ def _run_check_args(args: tuple[SweepSpec, dict, float]) -> dict:
     return run_check(*args)
 
 
-def run_monotonicity(
-    spec: SweepSpec,
-    records: list[dict],
-    out: Path,
-    workers: int = 1,
-    backend: str = "process",
-    progress: bool = True,
-    overwrite: bool = False,
-) -> dict:
-    """Run (or resume) the checks of the sweep ``records`` into ``out / monotonicity``;
+def run_monotonicity(spec: SweepSpec, records: list[dict], run: JobRun) -> dict:
+    """Run (or resume) the checks of the sweep ``records`` into ``run.out / monotonicity``;
     returns the report (:func:`summarize`)."""
     arguments = {
         check_key(record, fraction): (spec, record, fraction)
@@ -78,9 +71,10 @@ def run_monotonicity(
         if record["impulse"] > 0.0
         for fraction in FRACTIONS
     }
-    done = run_resumable(_run_check_args, arguments, out / FOLDER, spec, RESULT_FIELDS,
-                         SPEC_FILE, workers, backend, progress, "monotonicity", "runs",
-                         overwrite=overwrite)  # fmt: skip
+    into = replace(run, out=run.out / FOLDER)
+    done = run_resumable(
+        _run_check_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, into, "monotonicity", "runs"
+    )
     return summarize(spec, [done[key] for key in arguments])
 
 

@@ -44,6 +44,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from app.experiments.campaign import gait_config, robot_mass
+from app.experiments.jobs import JobRun
 from app.experiments.sweep import Job, SweepSpec, run_sweep
 from app.setup.build import resolve_robot
 from app.setup.overrides import Overrides
@@ -136,19 +137,10 @@ def protocol_jobs(spec: SweepSpec) -> list[Job]:
     ]
 
 
-def run_protocol(
-    spec: ProtocolSpec,
-    out: Path,
-    workers: int = 1,
-    backend: str = "process",
-    progress: bool = True,
-    overwrite: bool = False,
-) -> dict:
-    """Run (or resume) the protocol into ``out``; returns its table (:func:`table`)."""
+def run_protocol(spec: ProtocolSpec, run: JobRun) -> dict:
+    """Run (or resume) the protocol as ``run`` says; returns its table (:func:`table`)."""
     sweep = spec.sweep_spec()
-    records = run_sweep(
-        sweep, out, workers, backend, progress, protocol_jobs(sweep), "protocol", overwrite
-    )
+    records = run_sweep(sweep, run, protocol_jobs(sweep), "protocol")
     return table(spec, records)
 
 

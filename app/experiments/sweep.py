@@ -26,14 +26,13 @@ import json
 import math
 import time
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Protocol
 
 import numpy as np
 
 from app.experiments.bisection import bisect_threshold
 from app.experiments.capture_bound import impulse_bound
-from app.experiments.jobs import run_resumable
+from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.trial import SettledTrial, measured_touchdown, push_timing
 from app.scenarios import Scenario
 from app.setup.build import resolve_robot
@@ -328,16 +327,9 @@ def all_jobs(spec: SweepSpec) -> list[Job]:
 
 
 def run_sweep(
-    spec: SweepSpec,
-    out: Path,
-    workers: int = 1,
-    backend: str = "process",
-    progress: bool = True,
-    jobs: list[Job] | None = None,
-    label: str = "sweep",
-    overwrite: bool = False,
+    spec: SweepSpec, run: JobRun, jobs: list[Job] | None = None, label: str = "sweep"
 ) -> list[dict]:
-    """Run (or resume) the sweep into ``out``; returns the records of all its jobs
+    """Run (or resume) the sweep as ``run`` says; returns the records of all its jobs
     (``jobs``, default :func:`all_jobs`; ``label`` names the progress bar).
 
     Raises:
@@ -347,17 +339,6 @@ def run_sweep(
     jobs = all_jobs(spec) if jobs is None else jobs
     arguments = {job.key: (spec, job) for job in jobs}
     finished = run_resumable(
-        _run_job_args,
-        arguments,
-        out,
-        spec,
-        RESULT_FIELDS,
-        SPEC_FILE,
-        workers,
-        backend,
-        progress,
-        label,
-        overwrite=overwrite,
-        parse=_parse_record,
+        _run_job_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, run, label, parse=_parse_record
     )
     return [finished[job.key] for job in jobs]
