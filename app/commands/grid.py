@@ -19,8 +19,9 @@ from app.commands.arguments import (
     spec_from_args,
 )
 from app.experiments.grid import GridSpec, format_grid, run_grid, write_grid
+from app.experiments.plots import plot_grid
 from app.experiments.sweep import SWEEP_CONTROLLERS
-from app.results.folder import prepare_out
+from app.results.folder import prepare_out, report_files
 from app.results.worst_runs import (
     add_replays_argument,
     format_replays,
@@ -98,11 +99,8 @@ def run(args: argparse.Namespace) -> int:
     wall_time = time.perf_counter() - started
     paths = write_grid(args.out, spec, records, wall_time, replays)
     if not args.no_plots:
-        from app.experiments.plots import plot_grid
-
         paths.append(plot_grid(spec, records, args.out / "grid.png"))
-    for path in paths:
-        print(f"wrote {path}")
+    report_files(paths)
     print(format_grid(spec, records))
     print(format_replays(replays))
     print(f"grid: {len(records)} runs, {wall_time:.0f} s wall time")

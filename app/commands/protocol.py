@@ -15,6 +15,7 @@ from app.commands.arguments import (
 )
 from app.experiments.protocol import ProtocolSpec, format_protocol, run_protocol, write_protocol
 from app.experiments.sweep import SWEEP_CONTROLLERS
+from app.results.folder import report_files
 
 HELP = (
     "IHMC-style pushes forward, backward, inward and outward: largest fraction of "
@@ -67,8 +68,7 @@ def run(args: argparse.Namespace) -> int:
     started = time.perf_counter()
     document = run_protocol(spec, run_as)
     document["wall_time"] = time.perf_counter() - started
-    for path in write_protocol(args.out, document):
-        print(f"wrote {path}")
+    report_files(write_protocol(args.out, document))
     print(format_protocol(document))
     print(f"protocol: {document['wall_time']:.0f} s wall time; source: {document['source']}")
     return 0

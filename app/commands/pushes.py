@@ -16,7 +16,9 @@ from app.commands.arguments import (
 )
 from app.experiments.campaign import SEEDS, CampaignSpec, campaign_jobs, parse_seed, run_campaign
 from app.experiments.campaign_report import format_summary, push_rows, summarize, write_campaign
+from app.experiments.plots import plot_campaign
 from app.experiments.sweep import SWEEP_CONTROLLERS
+from app.results.folder import report_files
 from planner.exceptions import RsgError
 
 HELP = "push campaign: random pushes over a whole gait cycle, each beside its LIPM twin"
@@ -107,11 +109,8 @@ def run(args: argparse.Namespace) -> int:
     summary = summarize(spec, rows)
     paths = write_campaign(args.out, spec, rows, summary, wall_time)
     if not args.no_plots:
-        from app.experiments.plots import plot_campaign
-
         paths.append(plot_campaign(spec, rows, args.out / "campaign.png"))
-    for path in paths:
-        print(f"wrote {path}")
+    report_files(paths)
     print(format_summary(spec, summary))
     print(f"pushes: {len(campaign_jobs(spec))} runs, {wall_time:.0f} s wall time")
     return 0

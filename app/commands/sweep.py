@@ -18,6 +18,7 @@ from app.commands.arguments import (
 from app.experiments.envelope import build_envelope, format_table, write_envelope
 from app.experiments.plots import plot_envelope
 from app.experiments.sweep import PLACO_WPG, SweepSpec, run_sweep
+from app.results.folder import report_files
 from app.results.worst_runs import (
     add_replays_argument,
     format_replays,
@@ -109,8 +110,7 @@ def run(args: argparse.Namespace) -> int:
     envelope["wall_time"] = time.perf_counter() - started
     paths = write_envelope(args.out, envelope)
     paths.append(plot_envelope(envelope, args.out / "envelope.png"))
-    for path in paths:
-        print(f"wrote {path}")
+    report_files(paths)
     print(format_table(envelope))
     print(format_replays(envelope["replays"]))
     print(f"sweep: {len(records)} jobs, {envelope['wall_time']:.0f} s wall time")

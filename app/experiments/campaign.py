@@ -45,9 +45,9 @@ import numpy as np
 
 from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along
-from app.experiments.sweep import PLACO_WPG, check_pushes
+from app.experiments.sweep import PLACO_WPG, PushExperiment, check_pushes
 from app.scenarios import MAX_IMPULSE
-from app.setup.build import build_backend, resolve_robot
+from app.setup.build import build_backend
 from app.setup.overrides import Overrides, allowed_names
 from planner.exceptions import ParameterError
 from planner.parameters import LipmModel, PlannerConfig
@@ -93,13 +93,12 @@ def robot_mass(robot: str | None) -> float:
 
 
 @dataclass(frozen=True)
-class CampaignSpec:
+class CampaignSpec(PushExperiment):
     """What the campaign runs.
 
     Attributes:
-        model: ``pybullet`` or ``lipm``.
-        robot: As :class:`app.experiments.sweep.SweepSpec`'s (``None``: G1 on ``pybullet``).
-        controllers: Controllers to run each push with.
+        model, robot, controllers, paper_rules, fall_dcm_error, overrides: As
+            :class:`app.experiments.sweep.PushExperiment`'s.
         pushes: Number of pushes N.
         seed: Seed of the draws (:data:`SEEDS`).
         impulse: (low, high) impulse [N s]; ``None``: 5-10 N s times m / 33.3 kg.
@@ -107,14 +106,9 @@ class CampaignSpec:
         cycle: Step (>= 1) whose touchdown in the unpushed walk starts the gait cycle the
             pushes are drawn over.
         settle: Simulated time after the push start [s].
-        paper_rules: The RSG without the documented extensions.
-        fall_dcm_error: DCM error that counts as a fall on the LIPM [m] (the
-            sweep's 2 m: only the leg reach decides).
-        overrides: ``--set`` (name, value) pairs.
     """
 
     model: str = "pybullet"
-    robot: str | None = None
     controllers: tuple[str, ...] = ("rsg", "no-step")
     pushes: int = 100
     seed: int = SEEDS["dev"]
@@ -122,12 +116,9 @@ class CampaignSpec:
     duration: tuple[float, float] = (0.05, 0.2)
     cycle: int = 4
     settle: float = 8.0
-    paper_rules: bool = False
-    fall_dcm_error: float = 2.0
-    overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        super().__post_init__()
         check_pushes(self.model, self.controllers, 1, (0.0,), self.overrides, self.robot)
         if self.impulse is None:
             scale = robot_mass(self.robot) / REFERENCE_MASS

@@ -29,10 +29,8 @@ from pathlib import Path
 from app.experiments.capture_bound import impulse_bound
 from app.experiments.jobs import JobProgress, check_workers, run_in_processes
 from app.experiments.outcome import OUTCOMES, PushRun, describe, impulse_along
-from app.experiments.sweep import check_pushes
+from app.experiments.sweep import PushExperiment, check_pushes
 from app.experiments.trial import push_timing
-from app.setup.build import resolve_robot
-from app.setup.overrides import Overrides
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
 
@@ -40,27 +38,21 @@ MAX_IMPULSES = 100
 
 
 @dataclass(frozen=True)
-class GridSpec:
+class GridSpec(PushExperiment):
     """What the grid runs.
 
     Attributes:
-        model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on
-            ``pybullet`` and the paper's point mass on ``lipm``).
-        controllers: Controllers to compare.
+        model, robot, controllers, paper_rules, fall_dcm_error, overrides: As
+            :class:`app.experiments.sweep.PushExperiment`'s.
         impulses: Push impulses [N s].
         directions: Number of push directions, evenly spaced from 0 (forward).
         phases: Push phases p in [0, 1) of the walking cycle (as the sweep's).
         duration: Push duration [s].
         cycle: Walking cycle (>= 1) in which the push starts.
         settle: Simulated time after the push start [s].
-        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
-        fall_dcm_error: DCM error that counts as a fall on the LIPM [m].
-        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
     """
 
     model: str = "pybullet"
-    robot: str | None = None
     controllers: tuple[str, ...] = ("rsg", "fixed-timing", "no-step")
     impulses: tuple[float, ...] = (4.0, 6.0, 8.0, 10.0)
     directions: int = 8
@@ -68,12 +60,9 @@ class GridSpec:
     duration: float = 0.1
     cycle: int = 3
     settle: float = 8.0
-    paper_rules: bool = False
-    fall_dcm_error: float = 2.0
-    overrides: Overrides = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        super().__post_init__()
         check_pushes(
             self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
         )

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from app.experiments.sweep import PLACO_WPG, GridLike, build_controller
+from app.experiments.sweep import PLACO_WPG, PushExperiment, build_controller
 from app.experiments.trial import measured_touchdown
 from app.runner import RunResult
 from app.scenarios import Scenario
@@ -65,7 +65,7 @@ class PushRun:
             before :meth:`run`).
     """
 
-    def __init__(self, spec: GridLike, controller: str) -> None:
+    def __init__(self, spec: PushExperiment, controller: str) -> None:
         self.backend, self.config, self.initial, self.planner = build_controller(spec, controller)
 
     def touchdown(self, cycle: int) -> float:

@@ -26,7 +26,6 @@ import json
 import math
 import time
 from dataclasses import dataclass
-from typing import Protocol
 
 import numpy as np
 
@@ -45,19 +44,33 @@ from robots import DEFAULT_ROBOT
 PLACO_WPG = "placo-wpg"
 
 
-class GridLike(Protocol):
-    """What :func:`build_controller` reads of a specification."""
+@dataclass(frozen=True)
+class PushExperiment:
+    """What every push experiment (sweep, grid, campaign) shares: the controllers, the
+    model and robot they run on, and how they are built (:func:`build_controller`).
 
-    @property
-    def model(self) -> str: ...
-    @property
-    def robot(self) -> str | None: ...
-    @property
-    def paper_rules(self) -> bool: ...
-    @property
-    def fall_dcm_error(self) -> float: ...
-    @property
-    def overrides(self) -> Overrides: ...
+    Attributes:
+        model: ``lipm`` or ``pybullet``.
+        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on
+            ``pybullet`` and the paper's point mass on ``lipm``).
+        controllers: Controllers to compare.
+        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
+        fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
+            backend's own default (0.5 m) is a heuristic below the capturable DCM error
+            of many pushes (up to ~1 m); by default only its leg-reach rule decides (CoM
+            within 0.6 m of the stance ankle).
+        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
+    """
+
+    model: str = "lipm"
+    robot: str | None = None
+    controllers: tuple[str, ...] = CONTROLLERS
+    paper_rules: bool = False
+    fall_dcm_error: float = 2.0
+    overrides: Overrides = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
 
 
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
@@ -125,14 +138,12 @@ def check_pushes(
 
 
 @dataclass(frozen=True)
-class SweepSpec:
+class SweepSpec(PushExperiment):
     """What to sweep.
 
     Attributes:
-        model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on ``pybullet`` and
-            the paper's point mass on ``lipm``).
-        controllers: Controllers to compare.
+        model, robot, controllers, paper_rules, fall_dcm_error, overrides: As
+            :class:`PushExperiment`'s.
         directions: Number of push directions, evenly spaced.
         phases: Push phases p in [0, 1) of the walking cycle.
         duration: Push duration Delta [s].
@@ -142,21 +153,12 @@ class SweepSpec:
         bracket: Upper end of the bisection, times the capture bound [-].
         qp_solver: ``exact`` or ``proxqp`` for the QP (27) (equal results).
         criterion: ``recovered`` (RunResult.recovered) or ``no-fall``.
-        fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
-            backend's own default (0.5 m) is a heuristic below the capturable DCM
-            error of many pushes (up to ~1 m); the sweep keeps only its leg-reach
-            rule in effect (CoM within 0.6 m of the stance ankle) by default.
-        paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
-        overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
         timing: ``nominal``: the push starts at t_k + phase T^* with t_k the nominal
             touchdown (:func:`app.experiments.trial.push_timing`); ``touchdown``: t_k is
             the touchdown measured in the unpushed walk of each controller and model
             (:func:`app.experiments.trial.measured_touchdown`; ``rsg protocol``).
     """
 
-    model: str = "lipm"
-    robot: str | None = None
-    controllers: tuple[str, ...] = CONTROLLERS
     directions: int = 16
     phases: tuple[float, ...] = (0.0, 0.25, 0.5, 0.75)
     duration: float = 0.1
@@ -166,13 +168,10 @@ class SweepSpec:
     bracket: float = 1.1
     qp_solver: str = "exact"
     criterion: str = "recovered"
-    fall_dcm_error: float = 2.0
-    paper_rules: bool = False
-    overrides: Overrides = ()
     timing: str = "nominal"
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        super().__post_init__()
         check_pushes(
             self.model, self.controllers, self.directions, self.phases, self.overrides, self.robot
         )
@@ -218,7 +217,7 @@ def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
     return build_controller(spec, controller)[:3]
 
 
-def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
+def build_controller(spec: PushExperiment, controller: str):  # noqa: ANN202
     """Backend, configuration, initial condition and planner factory (None: the RSG's)
     of ``controller`` on ``spec``'s model and robot."""
     if controller == PLACO_WPG:
@@ -228,7 +227,7 @@ def build_controller(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN2
     return (*_build_rsg(spec, controller), None)
 
 
-def _build_rsg(spec: SweepSpec | GridLike, controller: str):  # noqa: ANN202
+def _build_rsg(spec: PushExperiment, controller: str):  # noqa: ANN202
     from app.setup.build import build_backend
 
     backend, config, initial = build_backend(

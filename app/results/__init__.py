@@ -1,0 +1,1 @@
+"""What a run leaves behind: its folder, files, Fig. 6 plots and replay."""

@@ -143,3 +143,9 @@ def prepare_out(
             raise ResultFolderError(path, f"cannot be deleted ({exc.strerror})", again) from exc
         removed.append(path)
     return removed
+
+
+def report_files(paths: list[Path]) -> None:
+    """Print the files a command wrote, one line each."""
+    for path in paths:
+        print(f"wrote {path}")
