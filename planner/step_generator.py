@@ -19,80 +19,25 @@ jump set D = D_T U D_S (14):
   D_T,2 = {sigma xi1y - w_y >= 0} (the CoM crosses the outer edge of the stance
   foot; sign convention as in :mod:`planner.step_qp`).
 
-Two departures from the paper, both documented in the README:
+Departures and extensions, one line each (why, flag and measurement:
+``docs/extensions.md``; the extensions are off under ``--paper-rules``):
 
-- The double-support compensation m g H^-1 r~_H is added to hdot after the
-  saturation of K_u e_u, not inside it. With a realistic bound on hdot the paper's
-  form saturates in every DSP of nominal walking (the term needs m g |r~_H|, about
-  165 N m for a 0.2 m x 0.2 m step at 60 kg), and the nominal gait alone would
-  leave {V_u <= gamma_v}. In the DSP, (1) with this term is the LIPM with its
-  effective ZMP at o_H + p~_H, inside the new foot's window, which the two feet on
-  the ground realise; constraint checks apply the hdot bound to the feedback part.
-- D_S is also gated by s~ >= T_DSP + T_SP. Without a push
-D_S is reached at s~ = T^* > T_DSP + T_SP, so nominal walking is unchanged; after an
-early step the reference may reach D_S sooner, before a real swing foot could land.
+- the double-support compensation m g H^-1 r~_H is added to hdot after the saturation
+  of K_u e_u (inside it, it saturates in every double support of nominal walking);
+- D_S is also gated by s~ >= T_DSP + T_SP (no step before a real swing foot is ready);
+- ``push_hold_time``: D_T,1 waits, at most that long, while the DCM shows a push
+  (f c_z / (m g) = p_cmd - p from two ticks' DCMs), so the QP sees the whole push;
+- ``step_reaction_time`` Delta: D_T is evaluated Delta ahead and schedules the
+  touchdown at min(max(s~ + Delta, T_DSP + T_SP), s~_nom), the QP solved at the state
+  predicted then; the decision is kept;
+- ``qp_at_timing_jump``: H_nu takes the QP's step for a timing jump even below gamma_v;
+- a backend's measured touchdown (``MeasuredState.touchdown``: jump at once) and stance
+  sole (``MeasuredState.stance_sole``: o_H follows it, over ``reanchor_time``).
 
-Documented extensions, each off under the paper's rules (``app.setup.paper_rules.PAPER_RULES``):
-``push_hold_time``, ``step_reaction_time`` (below) and ``qp_at_timing_jump``: H_nu
-takes the QP's step for a timing jump even below gamma_v (a jump from D_T,2 with
-V_u < gamma_v; a decision kept through the reaction time); the paper steps 2 xi1*.
-
-The first (``RsgParameters.push_hold_time``; 0 restores the paper's
-D_T exactly):
-
-- Push hold. D_T,1 is held back while a push is measured, for at most
-  ``push_hold_time`` (0.15 s). Once the swing foot is ready (s~ >= T_DSP + T_SP,
-  e.g. a push in the second half of single support), D_T,1 fires as soon as V_u
-  reaches gamma_v, 10-15 ms into a push, and the QP then places the step for the
-  still-small DCM error; the next step must wait T_DSP + T_SP while the push goes
-  on (on the LIPM, 0.27-0.49 of the capturability bound at phases 0.5 and 0.75 of
-  the cycle against 0.79-0.94 at phases 0 and 0.25). The push is estimated from
-  the measured DCM: over one period with constant inputs the LIPM gives
-  xi(t + T) = p + (xi(t) - p) e^(omega T), with p = p_cmd - f c_z / (m g) the
-  effective CMP, so f c_z / (m g) = p_cmd - p from the DCMs of two ticks (exact on
-  the LIPM, one tick late). While its size is at least ``push_cmp_threshold``
-  (2 cm, about 15 N at 60 kg) the step waits; when the push ends, the QP (27)
-  sees the whole DCM error. ``push_hold_time`` caps the delay for a push that lasts.
-  D_T,2 (the CoM past the outer edge of the foot) and D_S are not held. Without a
-  push the estimate is zero and nothing changes. Robots in PyBullet keep the
-  paper's D_T (:mod:`app.setup.robot_config`): the estimate there is not validated.
-
-Another, for a robot with legs, ``RsgParameters.step_reaction_time`` Delta
-(0, the default, is exactly the paper). The model's jump is instantaneous; a real
-swing foot needs time to reach a foothold the QP has moved. With Delta > 0, D_T is
-evaluated Delta ahead (s~ + Delta >= T_DSP + T_SP) and, when it fires, schedules the
-touchdown at s~_td = min(max(s~ + Delta, T_DSP + T_SP), s~_nom), s~_nom the
-reference's own (gated) step: a timing jump brings a step forward and never postpones
-it (without the cap, a push late in the single support, with the nominal touchdown
-less than Delta away, delayed the step by up to Delta; on G1 32 pushes at phases 0.8
-and 0.9, `rsg grid --controllers rsg --phases 0.8,0.9 --impulses 4,6 --settle 5`, were
-not fallen after 11 with the delay and 21 without). The decision is kept (even if
-V_u dips below gamma_v meanwhile, else the announced foothold flips between the
-QP's and the nominal one as V_u crosses gamma_v), ``next_step_time`` announces
-s~_td, and ``next_step`` is the QP (27) solved at the state predicted at s~_td (the
-LIPM under the current input, the reference flowing freely), re-solved every tick
-as s~_td approaches. At s~_td the jump happens with the QP at that tick's state, as
-in the paper. The touchdown time is fixed when the decision is made, so the
-foothold converges as the prediction horizon shrinks.
-
-A backend that switches the stance at measured contact reports the touchdown in
-``MeasuredState.touchdown``: in single support the planner then jumps at once, onto
-that foothold, before its own jump time (a timing jump). The default backends do not:
-the jump happens at the planned time (why: README, "When does the stance switch?").
-A backend may also report where the stance sole stands, measured, in
-``MeasuredState.stance_sole`` (the PyBullet backend's ``reanchor_stance``, once a step
-after the double support): in single support the planner moves o_H there, so its ZMP
-window and DCM error refer to the real foot. With ``RsgParameters.reanchor_time`` tau > 0
-o_H approaches the sole as a first-order lag (each tick by period / tau of the gap) instead
-of at once, so the DCM error moves by the landing offset over tau instead of in one tick;
-a step ends a re-anchoring still under way.
-
-Controllers in the same framework (``PlannerConfig.controller``):
-
-- ``rsg``: all of the above;
-- ``fixed-timing``: D_S alone, locations from the QP when V_u >= gamma_v;
-- ``no-step``: D_S alone and u_d = 2 xi1* always (nominal step times and
-  locations); feedback only through the ZMP and the angular momentum.
+Controllers in the same framework (``PlannerConfig.controller``): ``rsg``, all of the
+above; ``fixed-timing``, D_S alone with locations from the QP when V_u >= gamma_v;
+``no-step``, D_S alone and u_d = 2 xi1* always (feedback through the ZMP and the
+angular momentum only).
 """
 
 from __future__ import annotations

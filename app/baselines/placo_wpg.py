@@ -1,118 +1,26 @@
 """The ``placo-wpg`` baseline: placo's walk pattern generator with ``update_supports``.
 
-Why one long module: placo's generator, its re-planning and the adapter to the RSG's
-interface share one plan; the baseline is one concept.
+The baseline a placo user would pick (placo 0.10.2): its walk pattern generator
+re-planned with ``update_supports`` on the measured DCM, driving the same robot through
+the same whole-body IK and PyBullet backend as the RSG. :class:`PlacoWalkPlanner` has
+the generator's interface and is swapped into :class:`app.runner.ClosedLoop` through
+its ``planner`` factory. One line of why per choice below; the configuration, the tick
+and the measurements behind each choice: ``docs/baselines.md``.
 
-The baseline a placo user would pick (placo 0.10.2), driving the same robot through
-the same whole-body IK (:class:`kinematics.whole_body_ik.WholeBodyIK`) and the same
-PyBullet backend as the RSG. :class:`PlacoWalkPlanner` has the generator's
-interface (``reset(stance, previous)``, ``update(measured, period)``, ``design``)
-and is swapped into :class:`app.runner.ClosedLoop` through its ``planner`` factory.
+- one placo support per RSG step, no placo double support: the backend moves the
+  weight at the jump, and placo's mid-feet ZMP in double support cannot be realised;
+- the ZMP command is placo's plus the RSG's ZMP feedback on the DCM error: placo's
+  open-loop ZMP lets any DCM error grow as exp(omega t) on this backend;
+- ``update_supports`` every tick from T_DSP into a support, a replan only when the
+  step moves by ``STEP_TOLERANCE`` or ``TIME_TOLERANCE``: replanning every tick
+  chatters and falls;
+- a hard-constraint replan that is infeasible is redone with soft constraints: placo
+  otherwise drops the adaptation;
+- the jump ``CROSSING_DELAY`` into placo's support, when its ZMP is nearer the new
+  sole: the clipped plan then errs as much before the jump as after it.
 
-Configuration (:func:`humanoid_parameters`, all from the robot description and the
-RSG's :class:`planner.parameters.PlannerConfig`, so both walk the same gait):
-
-- one placo support per step of the RSG: ``single_support_duration`` = T_SSP +
-  T_DSP (0.8 s on G1), ``double_support_ratio`` = 0, ``single_support_timesteps``
-  = (T_SSP + T_DSP) / 0.05 s (the CoM QP's time step). The first T_DSP after each
-  jump is reported as the double support (``double_support``, ``time_since_step``)
-  and the next jump time as ``next_step_time``, from which the backend times the
-  feet: the robot walks the RSG's gait (0.1 s double, 0.7 s single support). Why:
-  the backend puts the weight on the new foot at the jump (``transfer_lift``), so
-  the CoP it can realise jumps from sole to sole there. With placo's own double
-  support (ratio T_DSP / T_SSP) the plan's ZMP stays at the midpoint between the
-  feet for ~0.1 s around every double support (measured on the nominal plan: 10
-  cm from both soles), which the backend clips onto a sole: the DCM error grew
-  to 5 cm in the first step and the walk fell at 1.4 s;
-- ``walk_com_height`` = c_z; ``feet_spacing`` = L_y; footsteps repeat forward at
-  L_x, ``STEPS_AHEAD`` steps ahead (``FootstepsPlannerRepetitive``);
-- the footstep frame is the centre of the sole rectangle (placo's support polygon
-  is centred on it, and its ZMP target in single support is that centre),
-  ``foot_length``/``foot_width`` the sole's size and ``zmp_margin`` the RSG's ZMP
-  margin (:data:`app.setup.robot_config.ZMP_MARGIN`); footholds in
-  :class:`planner.types.PlannerOutput` are ankle positions o_H, as for the RSG;
-- ``op_space_polygon`` (hard, where the next foot may land relative to the
-  stance foot): the RSG's step box u_d^m <= u_d <= u_d^M with the no-crossing
-  bound |u_d,y| >= 2 w_y + mu_2; ``dcm_offset_polygon`` (placo's soft
-  "viability" region of the DCM relative to the next foot at touchdown): half a
-  sole length fore and aft, half the step width sideways; both symmetric, as
-  placo mirrors them through the origin for a left stance foot;
-  ``walk_max_dx_forward``/``walk_max_dx_backward``/``walk_max_dy`` from u_d^M,
-  u_d^m (footstep clipping).
-
-Every control tick (:meth:`PlacoWalkPlanner.update`) from T_DSP after the start of
-placo's support (the RSG does not step in its double support either), as long as
-placo allows it (``can_replan_supports``):
-
-1. ``replan_supports(planner, trajectory, t, t_last_replan)``: the current support
-   and the footsteps ahead;
-2. ``update_supports(t, [current, next], measured DCM)``: placo's QP on the current
-   support's remaining duration and the next foot's location, fed the measured
-   DCM c + cdot / omega (``replan_supports`` leaves ``target_world_dcm`` at zero,
-   so it is set to the trajectory's DCM at the end of the current support,
-   ``get_part_end_dcm``). It moves the step only when the constant ZMP that would
-   bring the measured DCM to that target leaves the support polygon;
-3. ``replan(supports, trajectory, t)`` (a new CoM trajectory from the old one's
-   state at t: placo never resets its plan to the measurement) only when step 2
-   moved the next foot by more than ``STEP_TOLERANCE`` or the end of the support
-   by more than ``TIME_TOLERANCE``, and once per support to extend the horizon.
-   A replan that is infeasible with placo's hard ZMP constraints (placo then
-   keeps the old plan and drops the adaptation: 37 of 40 replans after a 3 cm
-   lateral DCM error) is redone with placo's soft ones (``soft``).
-
-Measured on G1 (walk without push): replanning at every tick costs 11-15 ms (above
-the 10 ms period) and fell at 6 s: ``update_supports`` is a dead-beat law whose
-response to a few mm of DCM error grows without bound near the end of a support,
-and the step chatter stirs the robot. Step tolerances of 5 mm or 1 cm, or
-adapting from 0.05 s into the support, fell at 18-24 s; with 2 cm, 10 ms and T_DSP
-the walk goes on for 25 s with about one replan per step.
-
-Command (read from the trajectory at t): footholds of the current/next supports,
-the CoM reference ``get_p_world_CoM``, and the ZMP ``get_p_world_ZMP`` plus the
-RSG's own ZMP feedback K_p e (K_p the ZMP rows of the RSG's LQR gain, 1.45 on G1;
-e = measured DCM - placo's DCM), clipped to the RSG's ZMP window around the
-stance ankle (``zmp_offset``, ``window_center`` = stance ankle); hdot = 0. Why the
-feedback: placo plans a CoM trajectory for a robot that tracks it, but this
-backend integrates the LIPM from the commanded ZMP (:mod:`app.backends.pybullet`),
-so placo's open-loop ZMP lets any DCM error grow as exp(omega t) (measured with
-placo's plan alone: 1 cm at 0.05 s, 7 cm at the first step, fall at 1.6 s). The
-baseline thus has the RSG's continuous ZMP feedback and differs from it in the
-reference and the step adaptation. Where placo's ZMP is outside the window
-(while it moves from sole to sole, ~50 ms per step: placo's ZMP is continuous and
-constrained at its 0.05 s samples only) the feed-forward is the sole centre,
-placo's ZMP target: clipping it there instead put the commanded CoP on the
-sole's edge at every jump, and the first adjusted step of the walk came at 15.9 s
-instead of 19.1 s (5 mm step tolerance).
-
-The jump (new stance foot, s~ = 0, ``step``) is the first tick of placo's new
-support at which placo's ZMP is nearer the new sole than the old one (or 0.05 s
-into it), ``CROSSING_DELAY`` (25 ms) after the support's start: then the clipped
-plan errs as much before the jump as after it (jumping at the support's start
-gave 2-3 cm of DCM error per step). ``next_step_time`` is the end of placo's
-support plus ``CROSSING_DELAY``.
-
-Not defined for this planner: the Lyapunov level V_u (reported 0; ``design``
-carries the RSG's gamma_v only so that the result files have the same fields).
-On the full robot, recovery is "no fall" for every controller.
-
-placo's step-time bounds are its own (hard-coded in 0.10.2): the current support
-may end 0.15 s after it started at the earliest, 3 s at the latest; the RSG
-waits at least T_DSP + T_SP after a step (T_SP = 0.5 s on G1). An earlier step
-finds the swing foot in the air; the backend then puts it down at once.
-
-Remaining limitations (measured): (1) the feet land a little off their commands
-(the real soles drift ~0.5 mm per step from the planned footholds, as for the
-RSG) and placo's plan, fixed in the world, does not follow them: the lateral DCM
-error at the jumps grows from +-6 mm to ~1 cm, and from ~17 s on
-``update_supports`` adjusts steps (max DCM error 2.8 cm in 25 s, no fall). (2)
-After a push the ZMP feedback pulls the robot toward placo's plan, which replan
-continues from its own (unpushed) state, while ``update_supports`` moves the foot
-for the measured DCM: once the plan has been replanned toward the moved foot the
-error changes sign and the foot is pulled back (5 N s sideways at 2.75 s: the
-left foot planned 7 cm outward, then put down 7 cm inward of nominal in the last
-50 ms; fall). Commanding placo's own ``get_optimal_zmp`` (the ZMP
-``update_supports`` assumes) instead of the feedback is coherent with it, but
-dead-beat too: the walk without push fell at 11.6 s.
+V_u is not defined for this planner (reported 0); on the full robot recovery is "no
+fall" for every controller.
 """
 
 from __future__ import annotations
