@@ -7,6 +7,9 @@ traceback, no RuntimeWarning, and no result written. An acceptance is documented
 (docs/input-validation.md) and checked for what it promises. The cases run in this
 process (``app.cli.main``) on the LIPM with short durations; a few run as subprocesses
 (real exit codes, signals) at the end of the file.
+
+Why one long module: it is one corpus, a table of cases with one runner, so that a
+new field's hostile values go where all the others are.
 """
 
 from __future__ import annotations

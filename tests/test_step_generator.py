@@ -1,4 +1,8 @@
-"""The reactive step generator in closed loop with the LIPM: the paper's claims."""
+"""The reactive step generator in closed loop with the LIPM: the paper's claims.
+
+Why one long module: the claims of Sections IV and V are checked on the same closed loop
+and share its fixtures; :mod:`planner.step_generator` is one module too.
+"""
 
 from dataclasses import replace
 
