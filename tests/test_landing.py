@@ -88,7 +88,7 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 def test_the_stance_settle_lowers_the_peak_touchdown_force():
     """G1's first two landings of the nominal walk: with the new stance sole's target
     settling over the double support, against one that jumps to the ground at the step
-    (which kicks the other foot off: 2.6 m g before the force difference control,
+    (which kicks the other foot off: 2.8 m g without the force difference control,
     1.9 m g with it, against 1.6 m g settled)."""
     settled = touchdown_peaks(True)
     jumped = touchdown_peaks(False)

@@ -22,7 +22,8 @@ class StabilizerConfig:
         friction: Coulomb coefficient of the wrench distribution's contacts [-].
         force_difference_rate: Height rate of the feet's targets per body weight of
             error in their normal-force difference with both feet down [m/s] (0: the
-            targets keep the planned heights); per weight, so one value suits G1 and Talos.
+            targets keep the planned heights); per weight, so one value is stable on G1
+            and Talos. On G1 only (its swing sole touches early; Talos's does not).
         flywheel_momentum: h_max, angular momentum the upper body may carry [N m s]
             (0: no flywheel; the whole hdot goes to the CoP).
         flywheel_return_time: T_r, band-pass of hdot for the flywheel and its return
@@ -34,7 +35,7 @@ class StabilizerConfig:
     estimator: str = "truth"
     landing_depth: float = 0.005
     friction: float = 0.7
-    force_difference_rate: float = 0.3
+    force_difference_rate: float = 0.0
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.5
