@@ -29,9 +29,7 @@ under position control, kept since):
 * ``sole_spinning_friction`` 0.01 m: a rubber pad resists turning about the ground
   normal (PyBullet's corner contacts would not).
 * the whole-body stabilizer's defaults (``app/stabilizer/config.py``) were chosen on
-  G1's development pushes; ``force_difference_rate`` 0.3 m/s: the swing sole touches
-  50 ms before the planned step and took a quarter of the weight there without it
-  (docs/notes/2026-12-03-force-difference.md).
+  G1's development pushes; ``backend_options`` stays empty.
 """
 
 from __future__ import annotations
@@ -139,5 +137,4 @@ G1 = RobotDescription(
     step_reaction_time=0.2,
     reanchor_time=0.2,
     dcm_inset=0.02,
-    backend_options={"force_difference_rate": 0.3},
 )

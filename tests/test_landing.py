@@ -88,10 +88,9 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 def test_the_stance_settle_lowers_the_peak_touchdown_force():
     """G1's first two landings of the nominal walk: with the new stance sole's target
     settling over the double support, against one that jumps to the ground at the step
-    (which kicks the other foot off: 2.8 m g without the force difference control,
-    1.9 m g with it, against 1.6 m g settled)."""
+    (which kicks the other foot off: measured 2.6 m g before)."""
     settled = touchdown_peaks(True)
     jumped = touchdown_peaks(False)
     assert len(settled) == len(jumped) == 2
-    assert max(settled) < 0.9 * max(jumped), f"{settled=} {jumped=}"
+    assert max(settled) < 0.8 * max(jumped), f"{settled=} {jumped=}"
     assert max(settled) < 2.0, settled  # [m g]

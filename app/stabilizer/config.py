@@ -20,10 +20,6 @@ class StabilizerConfig:
         landing_depth: How far below the ground the swing sole aims at the planned
             landing time [m], so it touches down by then rather than after.
         friction: Coulomb coefficient of the wrench distribution's contacts [-].
-        force_difference_rate: Height rate of the feet's targets per body weight of
-            error in their normal-force difference with both feet down [m/s] (0: the
-            targets keep the planned heights); per weight, so one value is stable on G1
-            and Talos. On G1 only (its swing sole touches early; Talos's does not).
         flywheel_momentum: h_max, angular momentum the upper body may carry [N m s]
             (0: no flywheel; the whole hdot goes to the CoP).
         flywheel_return_time: T_r, band-pass of hdot for the flywheel and its return
@@ -35,7 +31,6 @@ class StabilizerConfig:
     estimator: str = "truth"
     landing_depth: float = 0.005
     friction: float = 0.7
-    force_difference_rate: float = 0.0
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.5
@@ -55,7 +50,6 @@ class StabilizerConfig:
 RANGES: dict[str, tuple[float, float]] = {
     "landing_depth": (0.0, 0.02),
     "friction": (0.1, 2.0),
-    "force_difference_rate": (0.0, 2.0),
     "flywheel_momentum": (0.0, 10.0),
     "flywheel_return_time": (0.05, 10.0),
     "flywheel_cancel": (0.0, 1.0),

@@ -4,8 +4,7 @@
 
 * measure: the state estimate (:mod:`.estimator`) from the measurement record;
 * stabilize: the pivot the planner commands, the CoP and net force that realise it
-  (:mod:`.centroidal`), shared among the feet on the ground (:mod:`.wrench_distribution`),
-  the feet's heights adjusted so they carry their shares (:mod:`.force_difference`);
+  (:mod:`.centroidal`), shared among the feet on the ground (:mod:`.wrench_distribution`);
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
 * IK: placo's whole-body IK, with the upper body as a flywheel for hdot
   (:mod:`kinematics.upper_body`);
@@ -24,7 +23,6 @@ from app.lowlevel import JointCommand, RobotMeasurement
 from app.stabilizer import centroidal
 from app.stabilizer.config import StabilizerConfig
 from app.stabilizer.estimator import RobotState, StateEstimator
-from app.stabilizer.force_difference import FootLoads, ForceDifferenceControl
 from app.stabilizer.landing import Landing
 from app.stabilizer.wrench_distribution import ContactLimits, FootContact, distribute_wrench
 from kinematics.robot_model import RobotModel
@@ -97,9 +95,6 @@ class WholeBodyController:
             land_on_time=True,
         )
         self.landing = Landing(config.landing_depth, timing.double_support)
-        self.force_difference = ForceDifferenceControl(
-            config.force_difference_rate / (self.mass * GRAVITY)
-        )
         self.limits = ContactLimits(description.sole, friction=config.friction)
         self.stiffness, self.damping = joint_impedance(self.model, description)
         self._ankle_height = -float(description.sole_offset[2])
@@ -138,7 +133,6 @@ class WholeBodyController:
         """
         self._reset_state(np.asarray(com_xy, float))
         self.estimator.reset()
-        self.force_difference.reset()
         self._stance = stance
         q = self.ik.reset(soles["left"], soles["right"], com_xy)[self._ik_order]
         self.swing.start(soles[other_foot(stance)][:2, 3])
@@ -170,13 +164,12 @@ class WholeBodyController:
         com_target, _ = integrate_lipm(
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
-        feet, wrenches = self._contact_wrenches(command, measurement, force)
-        heights = self._force_difference(measurement, feet, wrenches)
         # swing foot
-        soles = self._sole_targets(command, stance, swing, heights)
+        soles = self._sole_targets(command, stance, swing)
         # IK
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
+        feet, wrenches = self._contact_wrenches(command, measurement, force)
         torque = self._feedforward(feet, wrenches)
         velocity = (q - self._targets[0]) / dt
         self._targets = (q, self._targets[0])
@@ -196,26 +189,11 @@ class WholeBodyController:
         self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
         self._stance = stance
 
-    def _force_difference(
-        self,
-        measurement: RobotMeasurement,
-        feet: list[Foot],
-        wrenches: list[NDArray[np.float64]],
-    ) -> dict[Foot, float]:
-        """Height offsets [m] of the feet's targets that make them carry their wrenches."""
-        given = {foot: float(wrench[2]) for foot, wrench in zip(feet, wrenches, strict=True)}
-        desired = FootLoads(given.get("left", 0.0), given.get("right", 0.0))
-        measured = FootLoads(measurement.normal_force("left"), measurement.normal_force("right"))
-        threshold = CONTACT_LOAD * self.mass * GRAVITY
-        both = min(measured.left, measured.right) > threshold  # a closed chain, planned or not
-        return self.force_difference.update(measured, desired, both, self.period)
-
     def _sole_targets(
-        self, command: PlannerOutput, stance: Foot, swing: Foot, heights: dict[Foot, float]
+        self, command: PlannerOutput, stance: Foot, swing: Foot
     ) -> dict[Foot, NDArray[np.float64]]:
         """4x4 targets of both soles: the stance sole on the planner's foothold, the
-        swing sole on its trajectory to the announced step, with the landing rules,
-        each raised by its force-difference offset ``heights`` [m]."""
+        swing sole on its trajectory to the announced step, with the landing rules."""
         dt = self.period
         time_since_step = command.time_since_step + dt
         landing_time = command.next_step_time - (command.time - command.time_since_step)
@@ -227,8 +205,7 @@ class WholeBodyController:
             stance_height = self.landing.stance_height(time_since_step)
         else:
             position[2] = self.landing.swing_height(position[2], landing_time - time_since_step)
-        foothold = np.array([*command.stance.position, stance_height + heights[stance]])
-        position[2] += heights[swing]
+        foothold = np.array([*command.stance.position, stance_height])
         return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position)}
 
     def _solve_ik(
