@@ -25,7 +25,8 @@ class StabilizerConfig:
         flywheel_return_time: T_r, band-pass of hdot for the flywheel and its return
             to the posture [s].
         flywheel_cancel: Share of the legs' high-passed angular momentum the upper
-            body takes back [-].
+            body takes back [-] (a leg swinging outwards otherwise pulls the pivot
+            off the stance sole's edge).
     """
 
     estimator: str = "truth"
@@ -33,7 +34,7 @@ class StabilizerConfig:
     friction: float = 0.7
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
-    flywheel_cancel: float = 0.5
+    flywheel_cancel: float = 0.75
 
     def __post_init__(self) -> None:
         if self.estimator not in SOURCES:
