@@ -14,6 +14,7 @@ from app.experiments.outcome import (
     settle_steps,
 )
 from app.runner import RunResult
+from app.scenarios import Scenario
 from planner.types import Push
 
 SPEC = GridSpec(model="lipm", controllers=("rsg", "no-step"), impulses=(1.0,), directions=1)
@@ -76,3 +77,54 @@ def test_a_push_the_ankle_absorbs_needs_no_step(runs: dict) -> None:
     assert settle_steps(result, push.time) == 0
     assert adjusted_steps_after(result, push.time) == 0
     assert np.all(result.column("lyapunov") < result.lyapunov_threshold)
+
+
+def test_a_push_after_the_last_step_is_not_judged_recovered(runs: dict) -> None:
+    """The last two nominal steps must come after the push: a push in the run's last
+    0.1 s that the steps before it could not see gives no verdict of recovery."""
+    end = START + 3.0
+    late = Push(end - 0.1, np.array([3.0, 0.0]), 0.05)
+    result = PushRun(SPEC, "rsg").run(late, end)
+    assert not result.fall.fell
+    last = result.steps[-2:]
+    assert all(not s.event["adjusted"] for s in last)
+    assert all(s.event["lyapunov_before"] < result.lyapunov_threshold for s in last)
+    assert last[-1].event["t"] < late.time
+    assert not result.recovered
+    assert outcome_of(result) == "survived"
+
+
+def test_v_u_is_judged_at_the_jumps(runs: dict) -> None:
+    """A step taken with V_u >= gamma_v among the last two is not a recovery, even at
+    the nominal location."""
+    result, _ = runs["recovered"]
+    assert result.recovered
+    gamma = result.lyapunov_threshold
+    steps = [*result.steps[:-1], _raised(result.steps[-1], gamma)]
+    above = RunResult(**{**vars(result), "steps": steps})
+    assert not above.recovered
+
+
+def _raised(step, level: float):  # noqa: ANN001, ANN202
+    return type(step)({**step.event, "lyapunov_before": level}, step.step)
+
+
+def test_an_unpushed_g1_walk_is_recovered_whatever_instant_it_ends(tmp_path, monkeypatch) -> None:
+    """On the robot V_u rises above gamma_v for about 0.1 s after every touchdown of
+    the nominal walk; a run ending there is still a recovered walk (G1 in PyBullet)."""
+    from app.runner import run_closed_loop
+    from app.scenarios import BUILT_IN
+    from app.setup.build import build_robot_backend
+
+    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path / "cache"))
+    backend, config, initial = build_robot_backend("g1", "rsg", ())
+    scenario = Scenario("walk", 7.35, BUILT_IN["walk"].pushes)
+    try:
+        result = run_closed_loop(backend, config, scenario, initial)
+    finally:
+        backend.close()
+    assert not result.steps[-1].event["adjusted"]
+    assert 0.0 < result.sim_time - result.steps[-1].event["t"] < 0.15  # just after a touchdown
+    assert result.final_lyapunov >= result.lyapunov_threshold  # the case judged here
+    assert result.recovered
+    assert outcome_of(result) == "recovered"

@@ -19,7 +19,9 @@ DEFINITIONS = {
     "delay": "phase T^*: the push starts this long after that touchdown [s]",
     "push_time": "start of the push in that run [s] (its model's touchdown + delay)",
     "velocity_change": "impulse / mass [m/s]",
-    "recovered": "no fall, V_u < gamma_v at the end, the last two steps nominal",
+    "recovered": (
+        "no fall, the last two steps after the push nominal, each taken with V_u < gamma_v"
+    ),
     "survived": "no fall within settle after the push start, not recovered",
     "adjusted_steps": "adjusted steps landing at or after the push start",
     "settle_steps": "touchdowns from the push start up to the last instant with V_u >= "

@@ -192,7 +192,10 @@ def write_grid(
         document = {
             "spec": asdict(spec),
             "outcomes": {
-                "recovered": "no fall, V_u < gamma_v at the end, last two steps nominal",
+                "recovered": (
+                    "no fall, the last two steps after the push nominal, "
+                    "each taken with V_u < gamma_v"
+                ),
                 "survived": "no fall within settle after the push start",
                 "fell": "fell",
             },

@@ -4,8 +4,8 @@ Shared by the push grid (:mod:`app.experiments.grid`), the push campaign
 (:mod:`app.experiments.campaign`) and the sweep's monotonicity check
 (:mod:`app.experiments.monotonicity`):
 
-* ``recovered``: no fall, V_u below gamma_v at the end and the last two steps
-  nominal (:attr:`app.runner.RunResult.recovered`);
+* ``recovered``: no fall, and the last two steps after the push nominal, each taken
+  with V_u below gamma_v (:attr:`app.runner.RunResult.recovered`);
 * ``survived``: no fall until the end of the run, but not recovered;
 * ``fell``.
 

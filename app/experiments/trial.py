@@ -50,9 +50,9 @@ class SettledTrial:
 
     The walk up to the push is simulated once; each trial deep-copies that loop, adds
     its push and runs on. The verdict is :attr:`RunResult.recovered` of the full run,
-    returned early: at a fall (False), or once the push is over, two nominal steps
-    have followed it and V_u < gamma_v at the second (True: from there the
-    undisturbed LIPM walks on nominally; a test checks the verdicts are equal).
+    returned early: at a fall (False), or once the push is over and two nominal steps
+    have followed it, each taken with V_u < gamma_v (True: from there the undisturbed
+    LIPM walks on nominally; a test checks the verdicts are equal).
 
     Args:
         backend, config, initial: As for :func:`app.runner.run_closed_loop`.
@@ -82,8 +82,9 @@ class SettledTrial:
             out = loop.tick()
             if backend.fall_status().fell:
                 return False
-            if out.step is not None and out.time > push_end:
-                nominal_in_a_row = 0 if out.step.adjusted else nominal_in_a_row + 1
-                if nominal_in_a_row >= 2 and out.lyapunov < loop.generator.design.threshold:
+            if out.step is not None and out.time >= push_end:
+                settled = out.step.lyapunov_before < loop.generator.design.threshold
+                nominal_in_a_row = nominal_in_a_row + 1 if settled and not out.step.adjusted else 0
+                if nominal_in_a_row >= 2:
                     return True
         return bool(loop.result().recovered)
