@@ -97,7 +97,8 @@ class ReferenceModel:
 
     def in_nominal_jump_set(self) -> bool:
         """D_S of (14): sign(xi2y*) xi1y* >= L_y^* / 2."""
-        return bool(np.sign(self.state[3]) * self.state[1] >= self.orbit.gait.step_width / 2)
+        # The orbit reaches D_S on a tick; rounding must not push the jump a tick later.
+        return bool(np.sign(self.state[3]) * self.state[1] >= self.orbit.gait.step_width / 2 - 1e-9)
 
     def energies(self) -> tuple[float, float]:
         """Current orbital energies (E_x, E_y) [m^2/s^2]."""

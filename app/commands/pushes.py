@@ -86,7 +86,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--cycle",
         type=int,
         default=CampaignSpec.cycle,
-        help="the push starts after the touchdown of this step (default 4: 3.17 s on G1)",
+        help="the push starts after the touchdown of this step (default 4: 3.1 s on G1)",
     )
     p.add_argument(
         "--settle",

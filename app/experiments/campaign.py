@@ -11,8 +11,8 @@ the same seed. In this order, each floored to a grid so that it is written exact
   (:func:`app.experiments.trial.measured_touchdown`). So the phase is the fraction of the
   gait cycle T^* since the last touchdown of the nominal walk, and a push hits the robot
   and its twin at the same point of their gaits (the loop steps at the first tick in
-  the nominal jump set, so touchdowns drift from the nominal t_k = T_SSP + (k - 1) T^*:
-  step 4 at 3.17 s on G1 in PyBullet, 3.107 s on its twin, t_4 = 3.1 s). Below
+  the nominal jump set: at the nominal t_k = T_SSP + (k - 1) T^* when the ticks fall
+  on it, step 4 at 3.1 s on G1 and on its twin, later otherwise). Below
   T_DSP / T^* (0.125 on G1) the push starts in double support. The default cycle 4 is
   three nominal steps after the start, on the left stance foot;
 * impulse uniform in ``impulse`` [N s], 0.01 N s; by default 5-10 N s on G1
@@ -265,7 +265,7 @@ def campaign_jobs(spec: CampaignSpec) -> list[CampaignJob]:
 
 def touchdowns(spec: CampaignSpec) -> dict[str, float]:
     """Time [s] of the touchdown of step ``cycle`` in the unpushed walk, per model
-    (``robot``, ``twin``) and controller: ``"robot|rsg"`` -> 3.17 on G1."""
+    (``robot``, ``twin``) and controller: ``"robot|rsg"`` -> 3.1 on G1."""
     found = {}
     for job in campaign_jobs(replace(spec, pushes=1)):
         on = spec.twin() if job.twin else spec

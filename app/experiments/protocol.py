@@ -19,7 +19,7 @@ Here the same in the RSG's gait, cycle ``cycle`` (default 4: the left foot is th
 stance foot, as in IHMC's tests), timed from the touchdown t_k of step k = ``cycle``
 measured in the unpushed walk of each controller and model, as IHMC's tests trigger on
 the gait state (:func:`app.experiments.trial.measured_touchdown`; on G1 in PyBullet t_4 is
-3.17 s, its nominal 3.1 s): double support is [t_k, t_k + T_DSP), the swing
+3.1 s, its nominal time): double support is [t_k, t_k + T_DSP), the swing
 [t_k + T_DSP, t_k + T^*). Forward (0 deg), backward (180 deg) and inward (90 deg) start
 at t_k + T_DSP + T_SSP / 2 (sweep phase (T_DSP + T_SSP / 2) / T^*, 0.5625 on G1),
 outward (270 deg) at t_k + T_DSP / 2 (phase 0.0625). A force of f m g over 0.1 s is an

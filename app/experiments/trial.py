@@ -25,10 +25,10 @@ def measured_touchdown(runner, backend, config, initial, cycle: int, **options) 
     (:func:`app.runner.run_closed_loop` or a backend's own) on ``backend``.
 
     The nominal t_k of :func:`push_timing` is where the reference enters D_S; the loop
-    steps at the first tick inside it, so each step lands up to two control periods
-    after its nominal time and the delays add up (G1 in PyBullet, 10 ms ticks: step 4
-    at 3.17 s instead of 3.1 s). A push timed from this touchdown hits the same point
-    of the gait on every model, as IHMC's tests trigger on the gait state.
+    steps at the first tick inside it: at t_k when the ticks fall on it (G1's 10 ms
+    ticks: step 4 at 3.1 s), up to a tick later otherwise, and the delays add up. A
+    push timed from this touchdown hits the same point of the gait on every model, as
+    IHMC's tests trigger on the gait state.
 
     Raises:
         RsgError: The walk fell or did not take ``cycle`` steps.
