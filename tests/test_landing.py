@@ -51,9 +51,10 @@ def test_the_new_stance_sole_settles_from_the_last_swing_height_to_the_ground():
 
 
 # ------------------------------------------------------------ on the full robot
-def touchdown_peaks(settle: bool, duration: float = 1.7) -> list[float]:
+def touchdown_peaks(settle: bool, duration: float = 1.7) -> tuple[list[float], bool]:
     """Largest total vertical ground force [-, of m g] per physics step around each
-    planned landing (0.15 s before to 0.1 s after) of G1's nominal walk."""
+    planned landing (0.15 s before to 0.1 s after) of G1's nominal walk, up to a fall;
+    and whether it fell."""
     backend, config, initial = build_robot_backend("g1", "rsg")
     if not settle:  # the new stance sole's target jumps to the ground at the step
         backend.controller.landing.stance_height = lambda time_since_step: 0.0
@@ -62,11 +63,14 @@ def touchdown_peaks(settle: bool, duration: float = 1.7) -> list[float]:
         scenario = dataclasses.replace(BUILT_IN["walk"], duration=duration)
         loop = ClosedLoop(backend, config, scenario, initial)
         steps = []
+        fell = False
         for _ in range(round(duration / loop.period)):
             out = loop.tick()
             if out.step is not None:
                 steps.append(out.time)
-            assert not backend.fall_status().fell
+            fell = backend.fall_status().fell
+            if fell:
+                break
         rows = np.array(backend.physics_log.rows)
         weight = backend.mass * GRAVITY
     finally:
@@ -77,7 +81,7 @@ def touchdown_peaks(settle: bool, duration: float = 1.7) -> list[float]:
     for time in steps:
         window = (column["t"] > time - 0.15) & (column["t"] < time + 0.1)
         peaks.append(float(total[window].max()))
-    return peaks
+    return peaks, fell
 
 
 @pytest.fixture(autouse=True)
@@ -86,11 +90,11 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 
 
 def test_the_stance_settle_lowers_the_peak_touchdown_force():
-    """G1's first two landings of the nominal walk: with the new stance sole's target
+    """G1's first landings of the nominal walk: with the new stance sole's target
     settling over the double support, against one that jumps to the ground at the step
-    (which kicks the other foot off: measured 2.6 m g before)."""
-    settled = touchdown_peaks(True)
-    jumped = touchdown_peaks(False)
-    assert len(settled) == len(jumped) == 2
-    assert max(settled) < 0.8 * max(jumped), f"{settled=} {jumped=}"
+    (which kicks the other foot off: about 3 m g, and G1 may fall)."""
+    settled, fell = touchdown_peaks(True)
+    jumped, _ = touchdown_peaks(False)
+    assert not fell and len(settled) == 2
+    assert settled[0] < 0.8 * jumped[0], f"{settled=} {jumped=}"
     assert max(settled) < 2.0, settled  # [m g]

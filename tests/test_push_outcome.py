@@ -13,8 +13,7 @@ from app.experiments.outcome import (
     outcome_of,
     settle_steps,
 )
-from app.runner import RunResult
-from app.scenarios import Scenario
+from app.runner import TIMESERIES_COLUMNS, RunResult
 from planner.types import Push
 
 SPEC = GridSpec(model="lipm", controllers=("rsg", "no-step"), impulses=(1.0,), directions=1)
@@ -109,22 +108,13 @@ def _raised(step, level: float):  # noqa: ANN001, ANN202
     return type(step)({**step.event, "lyapunov_before": level}, step.step)
 
 
-def test_an_unpushed_g1_walk_is_recovered_whatever_instant_it_ends(tmp_path, monkeypatch) -> None:
-    """On the robot V_u rises above gamma_v for about 0.1 s after every touchdown of
-    the nominal walk; a run ending there is still a recovered walk (G1 in PyBullet)."""
-    from app.runner import run_closed_loop
-    from app.scenarios import BUILT_IN
-    from app.setup.build import build_robot_backend
-
-    monkeypatch.setenv("RSG_CACHE_DIR", str(tmp_path / "cache"))
-    backend, config, initial = build_robot_backend("g1", "rsg", ())
-    scenario = Scenario("walk", 7.35, BUILT_IN["walk"].pushes)
-    try:
-        result = run_closed_loop(backend, config, scenario, initial)
-    finally:
-        backend.close()
-    assert not result.steps[-1].event["adjusted"]
-    assert 0.0 < result.sim_time - result.steps[-1].event["t"] < 0.15  # just after a touchdown
-    assert result.final_lyapunov >= result.lyapunov_threshold  # the case judged here
-    assert result.recovered
-    assert outcome_of(result) == "recovered"
+def test_the_runs_last_instant_does_not_decide(runs: dict) -> None:
+    """V_u above gamma_v at the last tick (a robot just after a touchdown) leaves a run
+    whose last two steps were nominal and taken below gamma_v recovered."""
+    result, _ = runs["recovered"]
+    series = result.timeseries.copy()
+    series[-1, TIMESERIES_COLUMNS.index("lyapunov")] = 2.0 * result.lyapunov_threshold
+    bumped = RunResult(**{**vars(result), "timeseries": series})
+    assert bumped.final_lyapunov >= bumped.lyapunov_threshold
+    assert bumped.recovered
+    assert outcome_of(bumped) == "recovered"

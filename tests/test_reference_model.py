@@ -49,3 +49,18 @@ def test_time_to_nominal_jump_matches_simulation():
         ref.flow(dt)
         elapsed += dt
     assert elapsed == pytest.approx(predicted, abs=2 * dt)
+
+
+@pytest.mark.parametrize("period", [0.001, 0.01])
+def test_the_step_comes_at_the_tick_one_period_after_the_last(period):
+    """Flowed in control ticks that divide T^*, the reference enters D_S at the tick
+    of each nominal step time, not a tick later, cycle after cycle."""
+    ref = ReferenceModel(ORBIT, sigma=1)
+    ticks = round(ORBIT.gait.step_duration / period)
+    for _ in range(3):
+        for _ in range(ticks - 1):
+            ref.flow(period)
+            assert not ref.in_nominal_jump_set()
+        ref.flow(period)
+        assert ref.in_nominal_jump_set()
+        ref.jump()
