@@ -185,8 +185,7 @@ def issue_pushes():
 
 def test_10_n_s_at_mid_single_support_topples_no_step_and_the_rsg_recovers_most(issue_pushes):
     """no-step falls after at least half of the 8 pushes; the RSG recovers, with
-    adjusted steps, at least 5 of them and
-    every push no-step recovers."""
+    adjusted steps, at least 5 of them and every push no-step recovers."""
     rsg, no_step = issue_pushes["rsg"], issue_pushes["no-step"]
     assert sum(r["outcome"] == "fell" for r in no_step.values()) >= 4
     recovered = [d for d, r in rsg.items() if r["outcome"] == "recovered"]

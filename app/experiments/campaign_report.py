@@ -9,7 +9,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from app.experiments.campaign import CampaignJob, CampaignPush, CampaignSpec, seed_name
-from app.experiments.outcome import OUTCOMES
+from app.experiments.outcome import OUTCOMES, RECOVERED_MEANS
 from planner.exceptions import RsgError
 
 FIGURES = ("push_time", "outcome", "fall_reason", "adjusted_steps", "settle_steps")
@@ -19,9 +19,7 @@ DEFINITIONS = {
     "delay": "phase T^*: the push starts this long after that touchdown [s]",
     "push_time": "start of the push in that run [s] (its model's touchdown + delay)",
     "velocity_change": "impulse / mass [m/s]",
-    "recovered": (
-        "no fall, the last two steps after the push nominal, each taken with V_u < gamma_v"
-    ),
+    "recovered": RECOVERED_MEANS,
     "survived": "no fall within settle after the push start, not recovered",
     "adjusted_steps": "adjusted steps landing at or after the push start",
     "settle_steps": "touchdowns from the push start up to the last instant with V_u >= "

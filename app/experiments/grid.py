@@ -28,7 +28,13 @@ from pathlib import Path
 
 from app.experiments.capture_bound import impulse_bound
 from app.experiments.jobs import JobProgress, check_workers, run_in_processes
-from app.experiments.outcome import OUTCOMES, PushRun, describe, impulse_along
+from app.experiments.outcome import (
+    OUTCOMES,
+    RECOVERED_MEANS,
+    PushRun,
+    describe,
+    impulse_along,
+)
 from app.experiments.sweep import PushExperiment, check_pushes
 from app.experiments.trial import push_timing
 from planner.exceptions import ParameterError, RsgError
@@ -192,10 +198,7 @@ def write_grid(
         document = {
             "spec": asdict(spec),
             "outcomes": {
-                "recovered": (
-                    "no fall, the last two steps after the push nominal, "
-                    "each taken with V_u < gamma_v"
-                ),
+                "recovered": RECOVERED_MEANS,
                 "survived": "no fall within settle after the push start",
                 "fell": "fell",
             },

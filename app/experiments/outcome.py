@@ -28,6 +28,10 @@ from app.scenarios import Scenario
 from planner.types import Push
 
 OUTCOMES = ("recovered", "survived", "fell")
+#: What ``recovered`` means, as written into result files.
+RECOVERED_MEANS = (
+    "no fall, the last two steps after the push nominal, each taken with V_u < gamma_v"
+)
 
 
 def outcome_of(result: RunResult) -> str:
