@@ -275,7 +275,7 @@ class ClosedLoop:
             time,
             self.measured.com_position,
             self.measured.com_velocity,
-            self.measured.touchdown,
+            self.measured.swing_contact,
             self.measured.stance_sole,
         )
         out = self.generator.update(measured, self.period)

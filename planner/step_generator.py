@@ -31,8 +31,9 @@ Departures and extensions, one line each (why, flag and measurement:
   touchdown at min(max(s~ + Delta, T_DSP + T_SP), s~_nom), the QP solved at the state
   predicted then; the decision is kept;
 - ``qp_at_timing_jump``: H_nu takes the QP's step for a timing jump even below gamma_v;
-- a backend's measured touchdown (``MeasuredState.touchdown``: jump at once) and stance
-  sole (``MeasuredState.stance_sole``: o_H follows it, over ``reanchor_time``).
+- a backend's swing contact (``MeasuredState.swing_contact``: a due jump waits for the
+  swing sole to touch down, its foothold kept) and stance sole
+  (``MeasuredState.stance_sole``: o_H follows it, over ``reanchor_time``).
 
 Controllers in the same framework (``PlannerConfig.controller``): ``rsg``, all of the
 above; ``fixed-timing``, D_S alone with locations from the QP when V_u >= gamma_v;
@@ -43,6 +44,7 @@ angular momentum only).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -56,6 +58,17 @@ from .types import Foot, Foothold, MeasuredState, PlannerOutput, StepEvent, sigm
 
 def _foot_of(sigma: int) -> Foot:
     return "left" if sigma > 0 else "right"
+
+
+@dataclass(frozen=True)
+class HeldStep:
+    """A jump that is due while the swing sole is still in the air: it comes at the
+    touchdown, onto ``foothold`` [m] (where the swing foot was sent); ``nominal`` and
+    ``from_qp`` say how it was decided."""
+
+    foothold: np.ndarray
+    nominal: bool
+    from_qp: bool
 
 
 class ReactiveStepGenerator:
@@ -103,6 +116,7 @@ class ReactiveStepGenerator:
         self.compensation_state = np.zeros(2)  # filtered m g H^-1 r~_H [N m]
         self.scheduled_step: float | None = None  # s~ of a decided timing jump
         self.announced_step: np.ndarray | None = None  # its foothold, last announced [m]
+        self.held_step: HeldStep | None = None  # a due jump waiting for the touchdown
         self.reference = ReferenceModel(self.orbit, self.sigma, s0)
         self._last_dcm: np.ndarray | None = None  # measured DCM at the last tick (world)
         self._last_cmp = np.zeros(2)  # effective CMP commanded over the last period
@@ -238,6 +252,15 @@ class ReactiveStepGenerator:
             return solution.step, True, solution.feasible
         return self.reference.nominal_step(), False, True
 
+    def _jump_step(
+        self, timing: bool, xi: np.ndarray, error: np.ndarray, level: float
+    ) -> tuple[np.ndarray, bool, bool]:
+        """u_d of a jump due now; returns (u_d, from_qp, qp_feasible)."""
+        if timing and self.announced_step is not None:
+            # The swing foot was sent to the foothold announced last tick: it lands there.
+            return self.announced_step - self.stance, True, True
+        return self._step_location(xi, error, level, self.qp_solver)
+
     def _nominal_wait(self) -> float:
         """Time [s] until the gated D_S: the reference's jump, not before s~ = T_DSP + T_SP."""
         ready = self.earliest_step - self.time_since_step
@@ -263,6 +286,8 @@ class ReactiveStepGenerator:
         """
         error = self.dcm_error(xi) if error is None else error
         level = self.design.level(error)
+        if self.held_step is not None:
+            return self.held_step.foothold.copy()
         if self.scheduled_step is not None and self.config.adjusts_location:
             delay = self.scheduled_step - self.time_since_step
             predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
@@ -288,6 +313,8 @@ class ReactiveStepGenerator:
         past, and not after the reference's step; otherwise the step comes when the
         reference reaches D_S.
         """
+        if self.held_step is not None:
+            return time
         if self.scheduled_step is not None:
             return time + max(self.scheduled_step - self.time_since_step, 0.0)
         if self.config.adjusts_timing and level >= self.design.threshold:
@@ -324,19 +351,21 @@ class ReactiveStepGenerator:
             and self._ready_to_step()
             and self.reference.in_nominal_jump_set()
         )
-        touchdown = measured.touchdown
-        if touchdown is not None and not (timing or nominal) and not self._in_double_support():
-            # The backend switches the stance at measured contact: the jump is now, onto
-            # the foot where it touched down.
-            timing = True
-            self.announced_step = np.asarray(touchdown, dtype=float).copy()
-        if timing or nominal:
-            if timing and self.announced_step is not None:
-                # The swing foot was sent to the foothold announced last tick: it lands there.
-                u_d, from_qp, feasible = self.announced_step - self.stance, True, True
-            else:
-                u_d, from_qp, feasible = self._step_location(xi, error, level, self.qp_solver)
+        if (timing or nominal) and measured.swing_contact is False and self.held_step is None:
+            # A late landing: the jump waits for the touchdown, onto the foothold due now.
+            u_d, from_qp, feasible = self._jump_step(timing, xi, error, level)
             qp_infeasible = not feasible
+            self.held_step = HeldStep(self.stance + u_d, nominal and not timing, from_qp)
+        if self.held_step is not None:
+            timing = nominal = False
+            if measured.swing_contact is not False:
+                held, self.held_step = self.held_step, None
+                nominal, timing = held.nominal, not held.nominal
+                u_d, from_qp, feasible = held.foothold - self.stance, held.from_qp, True
+        elif timing or nominal:
+            u_d, from_qp, feasible = self._jump_step(timing, xi, error, level)
+        if timing or nominal:
+            qp_infeasible = qp_infeasible or not feasible
             window_now = self.stance + self.window_offset()
             self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)
             self._reanchor_target = None

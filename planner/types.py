@@ -76,9 +76,9 @@ class MeasuredState:
         time: Time [s].
         com_position: Horizontal CoM c_H in the world [m], shape (2,).
         com_velocity: Horizontal CoM velocity [m/s], shape (2,).
-        touchdown: Where the swing foot has just touched the ground [m], shape (2,),
-            when the backend switches the stance at measured contact; None otherwise
-            (the planner then steps at its own jump time).
+        swing_contact: Whether the swing sole touches the ground, when the backend
+            measures it (foot force sensors); a jump that is due while it is False waits
+            for the touchdown. None: the planner steps at its own jump time.
         stance_sole: Where the stance foot's sole stands, measured [m], shape (2,),
             when the backend reports it (once a step, after the double support):
             the planner moves its stance foothold o_H there, so its ZMP window and
@@ -88,7 +88,7 @@ class MeasuredState:
     time: float
     com_position: Vector2
     com_velocity: Vector2
-    touchdown: Vector2 | None = None
+    swing_contact: bool | None = None
     stance_sole: Vector2 | None = None
 
 

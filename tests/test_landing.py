@@ -34,8 +34,9 @@ def test_the_swing_target_sinks_to_the_depth_by_the_landing_time_and_not_before(
     assert heights[0] == pytest.approx(profile)
     assert heights[-1] == pytest.approx(profile - DEPTH)
     assert np.all(np.diff(heights) < 0.0)  # going down all the way
-    late = rule.swing_height(profile, -0.05)  # a step that comes late
-    assert late == pytest.approx(profile - DEPTH)
+    # A touchdown that comes late: the target keeps going down at the same rate.
+    late = [rule.swing_height(profile, -t) for t in (0.05, 0.1)]
+    assert late == pytest.approx([profile - 1.5 * DEPTH, profile - 2.0 * DEPTH])
 
 
 def test_the_new_stance_sole_settles_from_the_last_swing_height_to_the_ground():
@@ -98,3 +99,34 @@ def test_the_stance_settle_lowers_the_peak_touchdown_force():
     assert not fell and len(settled) == 2
     assert settled[0] < 0.8 * jumped[0], f"{settled=} {jumped=}"
     assert max(settled) < 2.0, settled  # [m g]
+
+
+def test_a_late_landing_steps_at_the_touchdown():
+    """A forward push late in the swing (18 N s at 2.9 s) makes G1's swing foot land
+    after the planned step time (3.1 s): the planner's jump waits for the touchdown,
+    so at every step the new stance sole carries weight, and none is in the air."""
+    from app.stabilizer.controller import CONTACT_LOAD
+    from planner.types import Push
+
+    backend, config, initial = build_robot_backend("g1", "rsg")
+    try:
+        backend.physics_log = PhysicsLog()
+        scenario = dataclasses.replace(
+            BUILT_IN["walk"], duration=3.4, pushes=(Push(2.9, (18.0, 0.0), 0.1),)
+        )
+        loop = ClosedLoop(backend, config, scenario, initial)
+        steps = []
+        for _ in range(round(scenario.duration / loop.period)):
+            out = loop.tick()
+            if out.step is not None:
+                steps.append((out.time, out.step.foot))
+        rows = np.array(backend.physics_log.rows)
+        weight = backend.mass * GRAVITY
+    finally:
+        backend.close()
+    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    late = [time for time, _ in steps if time > 3.1 + 1e-9 and time < 3.3]
+    assert late, steps  # the step after the push came after its planned time
+    for time, foot in steps:
+        last = np.flatnonzero(column["t"] <= time + 1e-9)[-1]  # what the tick measured
+        assert column[f"{foot}_fz"][last] > CONTACT_LOAD * weight, (time, foot)

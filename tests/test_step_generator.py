@@ -398,30 +398,35 @@ def test_step_reaction_time_is_validated():
         _reaction_config(-0.1)
 
 
-def test_a_measured_touchdown_is_a_jump_onto_it_in_single_support_only():
-    """MeasuredState.touchdown: the backend switched the stance at contact (19b at that
-    foothold, a timing jump); in the double support it is ignored."""
+def test_a_due_jump_waits_for_the_swing_sole_to_touch_down():
+    """MeasuredState.swing_contact False when the nominal jump is due: no jump, the
+    foothold and the step time stay announced (now); at the touchdown the jump comes
+    onto that foothold, still a nominal step; with None the planner steps on time."""
     config = PlannerConfig()
-    gen = ReactiveStepGenerator(config)
-    gen.reset(
-        Foothold("left", np.array([0.0, 0.1])),
-        Foothold("right", np.array([-0.2, -0.1])),
-        time_since_step=0.05,  # double support
-    )
-    com, velocity = gen.initial_com_state()
-    landed = np.array([0.21, -0.12])
-    out = gen.update(MeasuredState(0.0, com, velocity, touchdown=landed), 0.01)
-    assert out.step is None
-    gen.time_since_step = 0.6  # single support, before the nominal jump at 0.8 s
-    com, velocity = gen.initial_com_state()
-    xi = np.r_[com - gen.stance, velocity]
-    error_before, reference_xi1 = gen.dcm_error(xi), gen.reference.xi1.copy()
-    out = gen.update(MeasuredState(0.01, com, velocity, touchdown=landed), 0.01)
-    assert out.step is not None and out.step.timing_adjusted
-    np.testing.assert_allclose(out.stance.position, landed)
-    assert out.stance.foot == "right"
-    u_d = landed - np.array([0.0, 0.1])
-    np.testing.assert_allclose(out.dcm_error, error_before - u_d + 2 * reference_xi1, atol=1e-9)
+
+    def walk(contact):
+        gen = ReactiveStepGenerator(config)
+        gen.reset(Foothold("left", np.array([0.0, 0.1])), Foothold("right", np.array([-0.2, -0.1])))
+        time, announced = 0.0, (np.zeros(2), 0.0)
+        while True:
+            # The nominal walk: the measured state is the reference's.
+            com, velocity = gen.initial_com_state()
+            out = gen.update(MeasuredState(time, com, velocity, swing_contact=contact(time)), 0.01)
+            if out.step is not None:
+                return out, announced
+            announced = (out.next_step.position.copy(), out.next_step_time)
+            time = round(time + 0.01, 9)
+
+    on_time, _ = walk(lambda time: None)
+    step_time = on_time.step.time
+    late, (foothold, announced_time) = walk(lambda time: time >= step_time + 0.05)
+    assert late.step.time == pytest.approx(step_time + 0.05)
+    assert announced_time == pytest.approx(step_time + 0.04)  # "now", while it waits
+    np.testing.assert_allclose(late.stance.position, foothold)
+    np.testing.assert_allclose(late.stance.position, on_time.stance.position, atol=1e-9)
+    assert not late.step.timing_adjusted and not late.step.location_adjusted
+    in_air, _ = walk(lambda time: time >= step_time + 0.05 or time < step_time)
+    assert in_air.step.time == pytest.approx(step_time + 0.05)
 
 
 def test_a_measured_stance_sole_moves_the_foothold_in_single_support_only():

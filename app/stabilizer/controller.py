@@ -284,14 +284,17 @@ class WholeBodyController:
     ) -> MeasuredState:
         """Estimate the state from ``measurement``; return what the planner reads: the
         CoM, its velocity and, in single support, the stance sole (the planner
-        re-anchors its foothold there)."""
+        re-anchors its foothold there) and whether the swing sole touches the ground
+        (a step due before the touchdown waits for it)."""
         self.state = state = self.estimator.update(measurement, stance)
-        sole = None
-        loaded = measurement.normal_force(stance) > CONTACT_LOAD * self.mass * GRAVITY
-        if not double_support and loaded:
-            sole = self.model.sole_frame(stance)[0][:2].copy()
+        sole, swing_contact = None, None
+        threshold = CONTACT_LOAD * self.mass * GRAVITY
+        if not double_support:
+            if measurement.normal_force(stance) > threshold:
+                sole = self.model.sole_frame(stance)[0][:2].copy()
+            swing_contact = measurement.normal_force(other_foot(stance)) > threshold
         return MeasuredState(
-            state.time, state.com[:2].copy(), state.com_velocity[:2].copy(), None, sole
+            state.time, state.com[:2].copy(), state.com_velocity[:2].copy(), swing_contact, sole
         )
 
 

@@ -5,7 +5,8 @@ Two rules on the height of the sole targets given to the IK:
 * contact by the planned time: over the last ``WINDOW`` before the planner's landing
   time the swing sole's target sinks to ``depth`` below the ground, so that a sole
   tracking a few millimetres high still touches down by the step (a late touchdown
-  leaves the CoP on the old foot while the planner has moved it to the new one);
+  leaves the CoP on the old foot), and past that time it keeps sinking at the same
+  rate until the sole touches down (the planner's jump waits for the touchdown);
 * continuity at the step: the new stance sole's target starts where the swing
   sole's last target was and reaches the ground by the end of the double support
   (a target that jumped there in one tick kicked the old foot off the ground: 2.6 m g
@@ -37,7 +38,8 @@ class Landing:
             profile: The swing trajectory's height [m].
             time_to_landing: Time left until the planned landing [s].
         """
-        sink = self.depth * min(max(1.0 - time_to_landing / WINDOW, 0.0), 1.0)
+        # Past the landing time (a late touchdown) it keeps sinking at the same rate.
+        sink = self.depth * max(1.0 - time_to_landing / WINDOW, 0.0)
         self._last_height = profile - sink
         return self._last_height
 
