@@ -13,7 +13,7 @@ from app.backends.physics_log import COLUMNS, PhysicsLog
 from app.runner import ClosedLoop
 from app.scenarios import BUILT_IN
 from app.setup.build import build_robot_backend
-from app.stabilizer.landing import WINDOW, Landing
+from app.stabilizer.landing import TOUCHDOWN_SPEED, WINDOW, Landing
 from planner.parameters import GRAVITY
 
 DEPTH = 0.005  # [m]
@@ -34,9 +34,10 @@ def test_the_swing_target_sinks_to_the_depth_by_the_landing_time_and_not_before(
     assert heights[0] == pytest.approx(profile)
     assert heights[-1] == pytest.approx(profile - DEPTH)
     assert np.all(np.diff(heights) < 0.0)  # going down all the way
-    # A touchdown that comes late: the target keeps going down at the same rate.
+    # A touchdown that comes late: the target goes on down at the touchdown speed.
     late = [rule.swing_height(profile, -t) for t in (0.05, 0.1)]
-    assert late == pytest.approx([profile - 1.5 * DEPTH, profile - 2.0 * DEPTH])
+    expected = [profile - DEPTH - t * TOUCHDOWN_SPEED for t in (0.05, 0.1)]
+    assert late == pytest.approx(expected)
 
 
 def test_the_new_stance_sole_settles_from_the_last_swing_height_to_the_ground():
