@@ -408,14 +408,14 @@ def test_a_due_jump_waits_for_the_swing_sole_to_touch_down():
         gen = ReactiveStepGenerator(config)
         gen.reset(Foothold("left", np.array([0.0, 0.1])), Foothold("right", np.array([-0.2, -0.1])))
         time, announced = 0.0, (np.zeros(2), 0.0)
-        while True:
-            # The nominal walk: the measured state is the reference's.
+        for _ in range(200):  # the nominal walk: the measured state is the reference's
             com, velocity = gen.initial_com_state()
             out = gen.update(MeasuredState(time, com, velocity, swing_contact=contact(time)), 0.01)
             if out.step is not None:
                 return out, announced
             announced = (out.next_step.position.copy(), out.next_step_time)
             time = round(time + 0.01, 9)
+        raise AssertionError("no step in 2 s")
 
     on_time, _ = walk(lambda time: None)
     step_time = on_time.step.time
@@ -425,6 +425,7 @@ def test_a_due_jump_waits_for_the_swing_sole_to_touch_down():
     np.testing.assert_allclose(late.stance.position, foothold)
     np.testing.assert_allclose(late.stance.position, on_time.stance.position, atol=1e-9)
     assert not late.step.timing_adjusted and not late.step.location_adjusted
+    # A sole that touched before the step time and lifts again: contact is no early jump.
     in_air, _ = walk(lambda time: time >= step_time + 0.05 or time < step_time)
     assert in_air.step.time == pytest.approx(step_time + 0.05)
 
