@@ -275,19 +275,20 @@ class ReactiveStepGenerator:
     ) -> np.ndarray:
         """Where the next step would land [m], re-planned at each tick.
 
-        With a timing jump scheduled it is the QP (27) at the state predicted at its
-        touchdown; with V_u >= gamma_v the QP at the current state; otherwise the
-        nominal step 2 xi1* at the reference's next (gated) nominal jump.
+        With a jump held for the touchdown it is that jump's foothold; with a timing
+        jump scheduled it is the QP (27) at the state predicted at its touchdown; with
+        V_u >= gamma_v the QP at the current state; otherwise the nominal step 2 xi1*
+        at the reference's next (gated) nominal jump.
 
         Args:
             xi: (c_H - o_H, cdot_H) now.
             nominal_wait: Time to the gated D_S [s], if already known.
             error: e_u of ``xi``, if already known [m].
         """
-        error = self.dcm_error(xi) if error is None else error
-        level = self.design.level(error)
         if self.held_step is not None:
             return self.held_step.foothold.copy()
+        error = self.dcm_error(xi) if error is None else error
+        level = self.design.level(error)
         if self.scheduled_step is not None and self.config.adjusts_location:
             delay = self.scheduled_step - self.time_since_step
             predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
