@@ -11,11 +11,11 @@ Choices, each with why (measurements: docs/results.md and the dated notes in
 docs/notes/, e.g. 2026-12-02-g1-position-control.md for the planner values chosen
 under position control, kept since):
 
-* ``swing_preparation_time`` T_SP = 0.3 s: the earliest step comes 0.4 s after a
-  touchdown, soon enough to catch most pushes towards the stance side; a swing landing
-  0.2 s after lift-off moves the 7 kg legs fast enough that their momentum shifts the
-  CoP off the sole (chosen on the development pushes under torque control,
-  docs/notes/2026-12-03-pivot.md).
+* ``swing_preparation_time`` T_SP = 0.25 s: the earliest step comes 0.35 s after a
+  touchdown, soon enough to catch pushes towards the stance side early in its single
+  support; with 0.2 s a pushed G1 falls into runs of quick crossing-limited steps (2.2x
+  the twin's adjusted steps) (chosen on the development pushes,
+  docs/notes/2026-12-03-quicker-step.md).
 * ``filter_time_constant`` theta = 0.01 s: at 0.05 s the planner's double-support
   pivot overshoots the new sole by up to 8 cm.
 * ``step_reaction_time`` 0.2 s: a swing foot needs time to reach a foothold the QP
@@ -134,7 +134,7 @@ G1 = RobotDescription(
         "right_shoulder_pitch_joint",
         "right_shoulder_roll_joint",
     ),
-    swing_preparation_time=0.3,
+    swing_preparation_time=0.25,
     angular_momentum_rate_max=5.0,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
