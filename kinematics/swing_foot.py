@@ -13,10 +13,9 @@ Timing (s~ = time since the last step [s]), from the planner's model:
 Measured on G1: arriving horizontally at the ready time (0.2 s after lift-off)
 needs foot accelerations of ~30 m/s^2; the legs (7 kg each of 33 kg) then shift
 the real ZMP by several cm and the stance foot pivots and spins. A swing timed
-on the planned step time is therefore the default; an early step (the planner's
-jump before ``landing``) finds the foot in the air: the caller then makes it the
-stance foot at the step position at once (the planner's jump happens at its
-planned time, not at measured contact).
+on the planned step time is therefore the default; a foot still in the air at
+the planned time is the caller's to bring down (the planner's jump then waits for
+the measured touchdown).
 
 Horizontally, each update re-plans a cubic from the current position/velocity to
 the current target with zero final velocity, over the time left until arrival
@@ -27,7 +26,7 @@ The height changes at most ``max_vertical_speed`` per second, so a change of the
 landing time does not make the foot jump.
 
 Reactive steps (the planner moves the step earlier and the foothold away while the
-foot is in the air) need two more bounds, both off by default:
+foot is in the air) need two more bounds, both off unless given:
 
 * ``max_acceleration`` [m/s^2]: the horizontal horizon is at least
   sqrt(6 d / a_max) for a distance d to go (the peak acceleration of a
@@ -76,25 +75,16 @@ class SwingTiming:
         return self.double_support + self.ready
 
 
-def swing_height(
-    time_since_step: float,
-    lift_off: float,
-    landing: float,
-    apex: float,
-    touchdown_speed: float = 0.0,
-) -> float:
+def swing_height(time_since_step: float, lift_off: float, landing: float, apex: float) -> float:
     """Height of the swing sole above the ground [m] at s~ [s].
 
-    ``apex * sin^2(pi phase) + touchdown_speed * T * phase (1 - phase)`` with
-    T = landing - lift_off and phase = (s~ - lift_off) / T clipped to [0, 1]:
-    zero height at both ends, vertical speed ``touchdown_speed`` [m/s] there
-    (0: the foot lands with zero vertical velocity).
+    ``apex * sin^2(pi phase)`` with phase = (s~ - lift_off) / (landing - lift_off)
+    clipped to [0, 1]: zero height and zero vertical velocity at both ends.
     """
     if landing <= lift_off:
         return 0.0
-    duration = landing - lift_off
-    phase = min(max((time_since_step - lift_off) / duration, 0.0), 1.0)
-    return apex * np.sin(np.pi * phase) ** 2 + touchdown_speed * duration * phase * (1 - phase)
+    phase = min(max((time_since_step - lift_off) / (landing - lift_off), 0.0), 1.0)
+    return apex * np.sin(np.pi * phase) ** 2
 
 
 class SwingFootTrajectory:
@@ -114,8 +104,6 @@ class SwingFootTrajectory:
         max_vertical_speed: float = 1.0,
         min_horizontal_time: float = 0.05,
         ground_height: float = 0.0,
-        touchdown_speed: float = 0.0,
-        smooth_horizontal: bool = False,
         max_acceleration: float | None = None,
         descent_slope: float = 0.0,
         land_on_time: bool = False,
@@ -131,10 +119,6 @@ class SwingFootTrajectory:
             max_vertical_speed: Bound on the vertical sole speed [m/s].
             min_horizontal_time: Shortest horizontal re-planning horizon [s].
             ground_height: Height of the ground [m].
-            touchdown_speed: Vertical speed of the sole at lift-off and touchdown
-                [m/s] (see :func:`swing_height`).
-            smooth_horizontal: Re-plan a minimum-jerk quintic (continuous
-                acceleration, zero at lift-off) instead of a cubic.
             max_acceleration: Bound [m/s^2] on the horizontal acceleration of
                 a re-planned approach (None: only ``min_horizontal_time``).
             descent_slope: Height [m] kept per metre still to go horizontally.
@@ -157,10 +141,6 @@ class SwingFootTrajectory:
         self.max_vertical_speed = max_vertical_speed
         self.min_horizontal_time = min_horizontal_time
         self.ground_height = ground_height
-        if not 0.0 <= touchdown_speed < max_vertical_speed:
-            raise ParameterError("touchdown_speed", touchdown_speed, "in [0, max_vertical_speed)")
-        self.touchdown_speed = touchdown_speed
-        self.smooth_horizontal = smooth_horizontal
         if max_acceleration is not None and not max_acceleration > 0.0:
             raise ParameterError("max_acceleration", max_acceleration, "> 0 m/s^2 or None")
         if not 0.0 <= descent_slope <= 10.0:
@@ -170,13 +150,11 @@ class SwingFootTrajectory:
         self.land_on_time = land_on_time
         self.position = np.zeros(3)
         self.velocity = np.zeros(2)
-        self.acceleration = np.zeros(2)
 
     def start(self, liftoff_position: NDArray[np.float64]) -> None:
         """Begin a swing from ``liftoff_position`` (x, y [, z]) [m], at rest."""
         self.position = np.array([liftoff_position[0], liftoff_position[1], self.ground_height])
         self.velocity = np.zeros(2)
-        self.acceleration = np.zeros(2)
 
     def update(
         self,
@@ -210,15 +188,7 @@ class SwingFootTrajectory:
                 if self.land_on_time:
                     bounded = min(bounded, max(landing - (time_since_step - dt), dt))
                 horizon = max(horizon, bounded)
-            if self.smooth_horizontal:
-                position, velocity, acceleration = _quintic_step(
-                    self.position[:2], self.velocity, self.acceleration, target, horizon, dt
-                )
-                self.acceleration = acceleration
-            else:
-                position, velocity = _cubic_step(
-                    self.position[:2], self.velocity, target, horizon, dt
-                )
+            position, velocity = _cubic_step(self.position[:2], self.velocity, target, horizon, dt)
             displacement = position - self.position[:2]
             limit = self.max_speed * dt
             norm = float(np.linalg.norm(displacement))
@@ -227,13 +197,7 @@ class SwingFootTrajectory:
                 velocity = displacement / dt
             self.position[:2] = self.position[:2] + displacement
             self.velocity = velocity
-        height = swing_height(
-            time_since_step,
-            timing.double_support,
-            landing,
-            self.apex_height,
-            self.touchdown_speed,
-        )
+        height = swing_height(time_since_step, timing.double_support, landing, self.apex_height)
         step_limit = self.max_vertical_speed * dt
         current = self.position[2] - self.ground_height
         if self.descent_slope > 0.0 and time_since_step > timing.double_support:
@@ -243,32 +207,6 @@ class SwingFootTrajectory:
             np.clip(height, current - step_limit, current + step_limit)
         )
         return self.position.copy()
-
-
-def _quintic_step(
-    position: NDArray[np.float64],
-    velocity: NDArray[np.float64],
-    acceleration: NDArray[np.float64],
-    target: NDArray[np.float64],
-    horizon: float,
-    dt: float,
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """State after ``dt`` on the quintic from (p, v, a) to (target, 0, 0) in ``horizon``."""
-    if dt >= horizon:
-        return target.copy(), np.zeros_like(target), np.zeros_like(target)
-    t = horizon
-    delta = target - position
-    # p(s) = p + v s + a s^2 / 2 + c3 s^3 + c4 s^4 + c5 s^5 with p(T) = target, v(T) = a(T) = 0.
-    c4 = (-30 * delta + 16 * velocity * t + 3 * acceleration * t**2) / (2 * t**4)
-    c5 = (12 * delta - 6 * velocity * t - acceleration * t**2) / (2 * t**5)
-    c3 = (20 * delta - 12 * velocity * t - 3 * acceleration * t**2) / (2 * t**3)
-    h = dt
-    new_position = (
-        position + velocity * h + acceleration * h**2 / 2 + c3 * h**3 + c4 * h**4 + c5 * h**5
-    )
-    new_velocity = velocity + acceleration * h + 3 * c3 * h**2 + 4 * c4 * h**3 + 5 * c5 * h**4
-    new_acceleration = acceleration + 6 * c3 * h + 12 * c4 * h**2 + 20 * c5 * h**3
-    return new_position, new_velocity, new_acceleration
 
 
 def _cubic_step(
