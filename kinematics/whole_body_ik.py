@@ -10,14 +10,13 @@ of the simulation and moves it, once per control tick, so that:
 * the joints stay near the standing posture (soft, low weight), within limits;
 * the description's ``locked_joints`` stay at their standing angle (masked: the
   physics URDF has them welded, :mod:`robots.urdf_merge`);
-* optionally, the centroidal angular momentum follows a target [N m s] (soft);
 * optionally (``upper_body=True``), the description's ``upper_body_joints`` follow
   their standing angles plus offsets given at each solve (soft, the trunk's
   weight, in place of the trunk orientation task): the upper body turns as a
   flywheel (:mod:`kinematics.upper_body`) while the CoM task keeps the CoM where
   the plan wants it.
 
-Its output is the joint target vector for the simulator's position control.
+Its output is the joint target vector of the joint motors' PD law.
 After each solve, :attr:`WholeBodyIK.angular_momentum` holds the centroidal
 angular momentum of the motion from the previous solution to this one [N m s]
 (the backend's CoM plan accounts for its rate: on G1 it shifts the CoP by up to
@@ -70,7 +69,6 @@ FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]
 COM_WEIGHT = 100.0  # CoM task weight [-]
 TRUNK_WEIGHT = 10.0  # trunk and pelvis orientation weight [-]
 POSTURE_WEIGHT = 1e-2  # joint posture regularisation weight [-]
-MOMENTUM_WEIGHT = 1e-2  # centroidal angular momentum weight, when enabled [-]
 
 
 def kinematic_urdf_text(description: RobotDescription) -> str:
@@ -121,15 +119,12 @@ class WholeBodyIK:
     def __init__(
         self,
         description: RobotDescription,
-        use_angular_momentum: bool = False,
         upper_body: bool = False,
     ) -> None:
         """Build the model and the tasks.
 
         Args:
             description: The robot.
-            use_angular_momentum: Add the centroidal angular momentum task fed by
-                :meth:`solve`'s ``angular_momentum`` argument.
             upper_body: Replace the trunk orientation task by a joint task on the
                 description's ``upper_body_joints``, fed by :meth:`solve`'s
                 ``upper_body_offsets``.
@@ -176,11 +171,6 @@ class WholeBodyIK:
         self.posture_task.set_joints(standing)
         self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
         self.upper_body_posture = np.array([standing[name] for name in self.upper_body_joints])
-        self.momentum_task = None
-        if use_angular_momentum:
-            self.momentum_task = self.solver.add_centroidal_momentum_task(np.zeros(3))
-            self.momentum_task.mask.set_axises("xy")
-            self.momentum_task.configure("angular_momentum", "soft", MOMENTUM_WEIGHT)
         self._support: Support | None = None
         self._previous_q: NDArray[np.float64] | None = None
         self.angular_momentum = np.zeros(3)
@@ -229,7 +219,7 @@ class WholeBodyIK:
         self.angular_momentum = np.zeros(3)
         self.solver.dt = 0.01
         for _ in range(iterations):
-            self._set_targets(com_xy, left_sole, right_sole, None)
+            self._set_targets(com_xy, left_sole, right_sole)
             self.solver.solve(True)
             self.robot.update_kinematics()
         return self.joint_angles()
@@ -239,7 +229,6 @@ class WholeBodyIK:
         com_xy: NDArray[np.float64],
         left_sole: NDArray[np.float64],
         right_sole: NDArray[np.float64],
-        angular_momentum: NDArray[np.float64] | None,
         upper_body_offsets: NDArray[np.float64] | None = None,
     ) -> None:
         self.foot_tasks["left"].T_world_frame = left_sole
@@ -256,9 +245,6 @@ class WholeBodyIK:
                 angles = angles + np.asarray(upper_body_offsets, float)
             self.upper_body_task.set_joints(dict(zip(self.upper_body_joints, angles, strict=True)))
         self.pelvis_task.R_world_frame = yaw_rotation(yaw)
-        if self.momentum_task is not None:
-            target = np.zeros(3) if angular_momentum is None else angular_momentum
-            self.momentum_task.L_world = np.array([target[0], target[1], 0.0])
 
     def com_z_target(
         self, left_sole: NDArray[np.float64], right_sole: NDArray[np.float64]
@@ -273,7 +259,6 @@ class WholeBodyIK:
         right_sole: NDArray[np.float64],
         support: Support,
         dt: float,
-        angular_momentum: NDArray[np.float64] | None = None,
         upper_body_offsets: NDArray[np.float64] | None = None,
     ) -> NDArray[np.float64]:
         """One IK step toward the targets.
@@ -283,9 +268,7 @@ class WholeBodyIK:
             left_sole: Left sole pose, 4x4 homogeneous [m].
             right_sole: Right sole pose, 4x4 homogeneous [m].
             support: Feet on the ground (their tasks are hard).
-            dt: Time since the previous solve [s] (for the momentum task).
-            angular_momentum: Centroidal angular momentum target [N m s], shape (2,)
-                or (3,), used when the momentum task is enabled.
+            dt: Time since the previous solve [s].
             upper_body_offsets: Offsets [rad] of :attr:`upper_body_joints` from
                 their standing angles, used when ``upper_body`` is enabled.
 
@@ -300,7 +283,7 @@ class WholeBodyIK:
             raise ParameterError("support", support, "'left', 'right' or 'both'")
         self._configure_support(support)
         self.solver.dt = dt
-        self._set_targets(com_xy, left_sole, right_sole, angular_momentum, upper_body_offsets)
+        self._set_targets(com_xy, left_sole, right_sole, upper_body_offsets)
         previous = np.array(self.robot.state.q, dtype=float)
         try:
             self.solver.solve(True)
