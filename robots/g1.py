@@ -13,9 +13,9 @@ under position control, kept since):
 
 * ``swing_preparation_time`` T_SP = 0.25 s: the earliest step comes 0.35 s after a
   touchdown, soon enough to catch pushes towards the stance side early in its single
-  support; with 0.2 s a pushed G1 falls into runs of quick crossing-limited steps (2.2x
-  the twin's adjusted steps) (chosen on the development pushes,
-  docs/notes/2026-12-03-quicker-step.md).
+  support; with 0.2 s the decision to step comes while V_u rises after each touchdown
+  and a pushed G1 takes 2.2x the twin's adjusted steps (chosen on the development
+  pushes, docs/notes/2026-12-03-quicker-step.md).
 * ``filter_time_constant`` theta = 0.01 s: at 0.05 s the planner's double-support
   pivot overshoots the new sole by up to 8 cm.
 * ``step_reaction_time`` 0.2 s: a swing foot needs time to reach a foothold the QP
