@@ -352,21 +352,19 @@ class ReactiveStepGenerator:
             and self._ready_to_step()
             and self.reference.in_nominal_jump_set()
         )
-        if (timing or nominal) and measured.swing_contact is False and self.held_step is None:
-            # A late landing: the jump waits for the touchdown, onto the foothold due now.
+        if self.held_step is None and (timing or nominal):
             u_d, from_qp, feasible = self._jump_step(timing, xi, error, level)
             qp_infeasible = not feasible
-            self.held_step = HeldStep(self.stance + u_d, nominal and not timing, from_qp)
+            if measured.swing_contact is False:
+                # A late landing: the jump waits for the touchdown, onto this foothold.
+                self.held_step = HeldStep(self.stance + u_d, nominal and not timing, from_qp)
+        elif self.held_step is not None and measured.swing_contact is not False:
+            held, self.held_step = self.held_step, None
+            nominal, timing = held.nominal, not held.nominal
+            u_d, from_qp = held.foothold - self.stance, held.from_qp
         if self.held_step is not None:
             timing = nominal = False
-            if measured.swing_contact is not False:
-                held, self.held_step = self.held_step, None
-                nominal, timing = held.nominal, not held.nominal
-                u_d, from_qp, feasible = held.foothold - self.stance, held.from_qp, True
-        elif timing or nominal:
-            u_d, from_qp, feasible = self._jump_step(timing, xi, error, level)
         if timing or nominal:
-            qp_infeasible = qp_infeasible or not feasible
             window_now = self.stance + self.window_offset()
             self.lyapunov_at_step = self.design.level(error - u_d + 2.0 * self.reference.xi1)
             self._reanchor_target = None
