@@ -107,6 +107,19 @@ def test_talos_walks_10_s_with_the_rsg_and_lands_where_planned():
     assert result.recovered
 
 
+def test_talos_catches_a_stance_side_push_with_a_step_beyond_g1s_reach():
+    """A 22 N s push toward the stance side early in the single support (development
+    push 66 of seed 1): Talos steps out wider than G1's 0.4 m bound allows (its bounds
+    are G1's in units of the CoM height), lands where planned and recovers. With G1's
+    bounds in metres it falls (measured)."""
+    push = Push(3.576, np.array([8.905, 20.0953]), 0.086)
+    result, errors = run_g1(Scenario("push", 7.5, (push,), reference_mass=None), robot="talos")
+    assert not result.fall.fell, result.fall.reason
+    assert max(errors) < LANDING_TOLERANCE
+    assert max(abs(s.step[1]) for s in result.steps) > 0.45  # u_d,y [m], G1: <= 0.4
+    assert result.recovered
+
+
 def test_g1_walks_60_s_without_drifting_into_an_adjusted_step():
     """No slow drift (a lateral CoP bias, a turn) carries the DCM out of the window over
     60 s of nominal walking: no adjusted step at all, and in single support V_u well
