@@ -16,8 +16,8 @@ x in [-0.33, 0.46] m, y in [-0.53, 0.53] m; with G1's bounds in metres Talos fel
 more stance-side pushes (docs/notes/2026-12-03-talos-reach.md). The whole-body
 stabilizer's defaults, chosen on G1, are used unchanged (its joint gains follow from
 each joint's effort limit); Talos lists no upper-body joints, so it has no flywheel
-and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders changed
-nothing measurable on the development pushes, the same note).
+and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders did no
+better on the development pushes, and worse taking back the legs' momentum; same note).
 """
 
 from __future__ import annotations
