@@ -22,11 +22,12 @@ under position control, kept since):
   has just moved (the planner decides an early step that long before touchdown).
 * ``reanchor_time`` 0.2 s: the planner moves its foothold to the measured stance
   sole over 0.2 s rather than in one tick.
-* ``step_min``/``step_max`` y -+0.6 m (x [-0.25, 0.35] m): the outward step after a
-  crossing step is what catches a push towards the stance side, and G1's hips roll
-  outwards up to 2.97 rad, so the lateral reach is the legs' (0.6 m is about 17 deg of
-  hip roll on each leg with the pelvis midway); development pushes with y +-0.4, 0.5,
-  0.6, 0.7 m: 93, 95, 97, 97 recovered (docs/notes/2026-12-04-g1-lateral-reach.md).
+* ``step_min``/``step_max`` y -+0.55 m (x [-0.25, 0.35] m): the outward step after a
+  crossing step is what catches a push towards the stance side; 0.55 m is the legs'
+  lateral reach, the widest stance with flat soles and the CoM midway at c_z
+  (``kinematics/reach.py``; the ankle rolls' +-15 deg end it). Development pushes with
+  y +-0.4, 0.5, 0.55, 0.6 m: 93, 95, 97, 97 recovered; at 0.6 m the IK had no solution
+  in some wide double supports (docs/notes/2026-12-04-lateral-reach.md).
 * ``dcm_inset`` 0.02 m and |hdot| <= 5 N m: the planner's row (27c') and the bound
   on its feedback angular momentum rate.
 * ``physics_time_step`` 2 ms with 75 solver iterations: the motors' stable PD law
@@ -139,8 +140,8 @@ G1 = RobotDescription(
         "right_shoulder_pitch_joint",
         "right_shoulder_roll_joint",
     ),
-    step_min=(-0.25, -0.6),
-    step_max=(0.35, 0.6),
+    step_min=(-0.25, -0.55),
+    step_max=(0.35, 0.55),
     swing_preparation_time=0.25,
     angular_momentum_rate_max=5.0,
     filter_time_constant=0.01,

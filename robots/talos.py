@@ -10,17 +10,16 @@ above the soles, 0.870 m standing on them in PyBullet, so c_z = 0.87 m. Hips are
 0.17 m apart. Joint torque limits are the URDF efforts (knee 300 N m).
 
 Walking: the paper's gait (L_x 0.1 m, L_y 0.2 m, T_DSP 0.1 s, T_SSP 0.7 s), T_SP 0.5 s,
-theta 0.01 s and a step reaction time of 0.2 s as on G1; 1 ms physics. The step bounds
-are G1's in units of the CoM height (the LIPM's length scale; 0.87/0.66 = 1.32):
-x in [-0.33, 0.46] m, y in [-0.79, 0.79] m, within the hip roll range (0.79 m is about
-22 deg of hip roll on each leg with the pelvis midway; the joints allow 30 deg). With
-G1's bounds in metres Talos fell on more stance-side pushes
-(docs/notes/2026-12-03-talos-reach.md, docs/notes/2026-12-04-g1-lateral-reach.md). The
-whole-body stabilizer's defaults, chosen on G1, are used unchanged (its joint gains
-follow from each joint's effort limit); Talos lists no upper-body joints, so it has no
-flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders
-did no better on the development pushes, and worse taking back the legs' momentum;
-docs/notes/2026-12-03-talos-reach.md).
+theta 0.01 s and a step reaction time of 0.2 s as on G1; 1 ms physics. Step bounds: y in
+[-0.87, 0.87] m, as on G1 the legs' lateral reach (the widest stance with flat soles and
+the CoM midway at c_z, ``kinematics/reach.py``; development pushes with y +-0.53, 0.66,
+0.79, 0.87 m: 87, 88, 90, 90 recovered); x in [-0.33, 0.46] m, G1's in units of the CoM
+height (the LIPM's length scale, 0.87/0.66 = 1.32; docs/notes/2026-12-03-talos-reach.md,
+docs/notes/2026-12-04-lateral-reach.md). The whole-body stabilizer's defaults, chosen
+on G1, are used unchanged (its joint gains follow from each joint's effort limit); Talos
+lists no upper-body joints, so it has no flywheel and the whole hdot goes to the CoP (a
+flywheel of the torso and the shoulders did no better on the development pushes, and
+worse taking back the legs' momentum; docs/notes/2026-12-03-talos-reach.md).
 """
 
 from __future__ import annotations
@@ -87,8 +86,8 @@ TALOS = RobotDescription(
     fall_base_height=0.6,
     swing_height=0.06,
     sole_box_collision=True,
-    step_min=(-0.33, -0.79),  # G1's (-0.25, -0.6) m x 0.87 / 0.66
-    step_max=(0.46, 0.79),  # G1's (0.35, 0.6) m x 0.87 / 0.66
+    step_min=(-0.33, -0.87),  # x: G1's x 0.87 / 0.66; y: the legs' reach
+    step_max=(0.46, 0.87),
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,

@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from kinematics.reach import lateral_reach
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
-from kinematics.whole_body_ik import WholeBodyIK, sole_pose
+from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
 from robots import get_robot
 
@@ -173,3 +174,56 @@ def test_swing_bounds_are_validated():
         SwingFootTrajectory(TIMING, max_acceleration=0.0)
     with pytest.raises(ParameterError, match="descent_slope"):
         SwingFootTrajectory(TIMING, descent_slope=-1.0)
+
+
+@pytest.mark.parametrize("robot", ["g1", "talos"])
+def test_each_robots_outward_step_bound_is_its_legs_lateral_reach(robot):
+    """The planner's widest outward step is the widest flat-footed stance the legs hold
+    with the CoM midway (kinematics/reach.py), to within 1 cm below it: a wider bound
+    plans double supports the joints cannot stand in, a narrower one gives away reach."""
+    description = get_robot(robot)
+    reach = lateral_reach(description)
+    for bound in (description.step_max[1], -description.step_min[1]):
+        assert reach - 0.01 <= bound <= reach, (robot, bound, reach)
+
+
+def test_g1s_lateral_reach_ends_where_its_ankle_rolls_reach_their_limits():
+    """G1's ankle roll joints turn +-15 deg, less than its hips: spread to its reach with
+    flat soles, both ankle rolls are at their limits, and 2 cm wider the IK can no longer
+    keep the soles where they are asked at the CoM height."""
+    description = get_robot("g1")
+    reach = lateral_reach(description)
+    ik = WholeBodyIK(description)
+    width = description.foot_spacing
+    ik.reset(*_stance(width), np.zeros(2))
+    while width < reach + 0.02 - 1e-9:
+        width = min(width + 0.005, reach + 0.02)
+        left, right = _stance(width)
+        try:
+            for _ in range(20):
+                ik.solve(np.zeros(2), left, right, "both", 0.01)
+        except IkInfeasibleError:
+            break
+        if abs(width - reach) < 1e-9:
+            angles = dict(zip(ik.joint_names, ik.joint_angles(), strict=True))
+            for side in ("left", "right"):
+                assert abs(angles[f"{side}_ankle_roll_joint"]) == pytest.approx(
+                    np.radians(15.0), abs=0.01
+                )
+    else:
+        sole_error = max(
+            float(np.linalg.norm(ik.sole_world(foot)[:3, 3] - target[:3, 3]))
+            for foot, target in zip(("left", "right"), _stance(width), strict=True)
+        )
+        height_error = abs(float(ik.com_world()[2]) - description.com_height)
+        assert sole_error > 0.005 or height_error > 0.01
+
+
+def _stance(width: float) -> tuple[np.ndarray, np.ndarray]:
+    return sole_pose(np.array([0.0, width / 2, 0.0])), sole_pose(np.array([0.0, -width / 2, 0.0]))
+
+
+def test_lateral_reach_rejects_a_bad_increment():
+    with pytest.raises(ParameterError) as caught:
+        lateral_reach(get_robot("g1"), increment=0.0)
+    assert (caught.value.field, caught.value.value) == ("increment", 0.0)
