@@ -119,6 +119,19 @@ def test_talos_catches_a_stance_side_push_with_a_wide_outward_step():
     assert result.recovered
 
 
+def test_g1_catches_a_stance_side_push_with_an_outward_step_wider_than_0_4_m():
+    """9.6 N s toward the stance side in the single support (development push 26 of
+    seed 1): G1 steps out more than 0.45 m (its bound is its legs' reach, 0.55 m),
+    recovers, and walks on landing where planned. With a 0.4 m bound it falls
+    (measured)."""
+    push = Push(3.3744, np.array([1.9508, 9.4201]), 0.077)
+    result, errors = run_g1(Scenario("push", 8.4, (push,), reference_mass=None))
+    assert not result.fall.fell, result.fall.reason
+    assert max(abs(s.step[1]) for s in result.steps) > 0.45  # u_d,y [m]
+    assert result.recovered
+    assert max(errors[-5:]) < LANDING_TOLERANCE
+
+
 def test_g1_walks_60_s_without_drifting_into_an_adjusted_step():
     """No slow drift (a lateral CoP bias, a turn) carries the DCM out of the window over
     60 s of nominal walking: no adjusted step at all, and in single support V_u well
