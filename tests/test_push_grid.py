@@ -70,17 +70,17 @@ def test_the_command_writes_the_grid_and_its_plot(tmp_path: Path, capsys) -> Non
 
 def test_a_push_above_its_capture_bound_falls_and_is_marked() -> None:
     """G1's planner on the LIPM at phase 0.25 (right stance): towards the stance side
-    (270 deg) no stepping controller can take 14 N s (the bound, 12.5 N s with G1's
-    5 N m hdot bound and first step 0.35 s after the touchdown, is below it), forward
-    the bound is several times larger and the push is recovered."""
+    (270 deg) no stepping controller can take 18 N s (the bound, 16.2 N s with G1's
+    5 N m hdot bound, first step 0.35 s after the touchdown and 0.55 m outward reach, is
+    below it), forward the bound is several times larger and the push is recovered."""
     spec = GridSpec(
-        model="lipm", robot="g1", controllers=("rsg",), impulses=(14.0,), directions=4,
+        model="lipm", robot="g1", controllers=("rsg",), impulses=(18.0,), directions=4,
         phases=(0.25,),
     )  # fmt: skip
     records = {r["direction_deg"]: r for r in run_grid(spec, workers=1, progress=False)}
     sideways, forward = records[270.0], records[0.0]
     assert sideways["stance"] == "right"
-    assert sideways["capture_bound"] < 14.0 < forward["capture_bound"] / 2.0
+    assert sideways["capture_bound"] < 18.0 < forward["capture_bound"] / 2.0
     assert sideways["outcome"] == "fell"
     assert forward["outcome"] == "recovered"
     summary = summarize(spec, list(records.values()))
