@@ -21,6 +21,7 @@ SOLE_TOLERANCE = 0.005  # [m] a sole this far from its target is not held
 TILT_TOLERANCE = 0.01  # [rad] nor one turned this far from flat
 COM_HEIGHT_TOLERANCE = 0.01  # [m] nor a CoM this far from its nominal height
 ITERATIONS = 20  # IK solves per separation (10 ms each)
+MAX_WIDTH = 3.0  # [m] no biped's legs reach further: the search ends there
 
 
 def lateral_reach(description: RobotDescription, increment: float = 0.005) -> float:
@@ -40,7 +41,7 @@ def lateral_reach(description: RobotDescription, increment: float = 0.005) -> fl
     ik = WholeBodyIK(description)
     width = description.foot_spacing
     ik.reset(_sole(width, "left"), _sole(width, "right"), np.zeros(2))
-    while True:
+    while width + increment <= MAX_WIDTH:
         trial = width + increment
         left, right = _sole(trial, "left"), _sole(trial, "right")
         try:
@@ -62,6 +63,7 @@ def lateral_reach(description: RobotDescription, increment: float = 0.005) -> fl
         ):
             return width
         width = trial
+    return width
 
 
 def _sole(width: float, foot: str) -> np.ndarray:
