@@ -12,6 +12,7 @@ longer hold them.
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import NDArray
 
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
@@ -26,8 +27,8 @@ MAX_WIDTH = 3.0  # [m] no biped's legs reach further: the search ends there
 
 def lateral_reach(description: RobotDescription, increment: float = 0.005) -> float:
     """Widest lateral distance between the soles [m] at which the whole-body IK holds
-    both soles flat on the ground (within 5 mm and 0.01 rad of their targets) with the
-    CoM midway, within 1 cm of ``description.com_height``.
+    both soles flat on the ground with the CoM midway (:func:`holds`), the soles spread
+    ``increment`` at a time from the nominal stance.
 
     Args:
         description: The robot.
@@ -40,32 +41,39 @@ def lateral_reach(description: RobotDescription, increment: float = 0.005) -> fl
         raise ParameterError("increment", increment, "a number in (0, 0.05] m")
     ik = WholeBodyIK(description)
     width = description.foot_spacing
-    ik.reset(_sole(width, "left"), _sole(width, "right"), np.zeros(2))
-    while width + increment <= MAX_WIDTH:
-        trial = width + increment
-        left, right = _sole(trial, "left"), _sole(trial, "right")
-        try:
-            for _ in range(ITERATIONS):
-                ik.solve(np.zeros(2), left, right, "both", 0.01)
-        except IkInfeasibleError:
-            return width
-        soles = [ik.sole_world("left"), ik.sole_world("right")]
-        sole_error = max(
-            float(np.linalg.norm(pose[:3, 3] - target[:3, 3]))
-            for pose, target in zip(soles, (left, right), strict=True)
-        )
-        tilt = max(float(np.arccos(np.clip(pose[2, 2], -1.0, 1.0))) for pose in soles)
-        height_error = abs(float(ik.com_world()[2]) - description.com_height)
-        if (
-            sole_error > SOLE_TOLERANCE
-            or tilt > TILT_TOLERANCE
-            or height_error > COM_HEIGHT_TOLERANCE
-        ):
-            return width
-        width = trial
+    ik.reset(*stance(width), np.zeros(2))
+    while width + increment <= MAX_WIDTH and holds(ik, description, width + increment):
+        width += increment
     return width
 
 
-def _sole(width: float, foot: str) -> np.ndarray:
-    side = 1.0 if foot == "left" else -1.0
-    return sole_pose(np.array([0.0, side * width / 2.0, 0.0]))
+def holds(ik: WholeBodyIK, description: RobotDescription, width: float) -> bool:
+    """Whether ``ik``, from its present state, holds the soles ``width`` [m] apart, flat on
+    the ground (within 5 mm and 0.01 rad of their targets), with the CoM midway within
+    1 cm of ``description.com_height``."""
+    targets = stance(width)
+    try:
+        for _ in range(ITERATIONS):
+            ik.solve(np.zeros(2), *targets, "both", 0.01)
+    except IkInfeasibleError:
+        return False
+    soles = [ik.sole_world("left"), ik.sole_world("right")]
+    sole_error = max(
+        float(np.linalg.norm(pose[:3, 3] - target[:3, 3]))
+        for pose, target in zip(soles, targets, strict=True)
+    )
+    tilt = max(float(np.arccos(np.clip(pose[2, 2], -1.0, 1.0))) for pose in soles)
+    height_error = abs(float(ik.com_world()[2]) - description.com_height)
+    return (
+        sole_error <= SOLE_TOLERANCE
+        and tilt <= TILT_TOLERANCE
+        and height_error <= COM_HEIGHT_TOLERANCE
+    )
+
+
+def stance(width: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Left and right sole poses (4x4) ``width`` [m] apart about the origin, flat."""
+    return (
+        sole_pose(np.array([0.0, width / 2.0, 0.0])),
+        sole_pose(np.array([0.0, -width / 2.0, 0.0])),
+    )

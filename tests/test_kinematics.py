@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kinematics.reach import lateral_reach
+from kinematics.reach import holds, lateral_reach, stance
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
-from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
+from kinematics.whole_body_ik import WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
 from robots import get_robot
 
@@ -195,32 +195,14 @@ def test_g1s_lateral_reach_ends_where_its_ankle_rolls_reach_their_limits():
     reach = lateral_reach(description)
     ik = WholeBodyIK(description)
     width = description.foot_spacing
-    ik.reset(*_stance(width), np.zeros(2))
-    while width < reach + 0.02 - 1e-9:
-        width = min(width + 0.005, reach + 0.02)
-        left, right = _stance(width)
-        try:
-            for _ in range(20):
-                ik.solve(np.zeros(2), left, right, "both", 0.01)
-        except IkInfeasibleError:
-            break
-        if abs(width - reach) < 1e-9:
-            angles = dict(zip(ik.joint_names, ik.joint_angles(), strict=True))
-            for side in ("left", "right"):
-                assert abs(angles[f"{side}_ankle_roll_joint"]) == pytest.approx(
-                    np.radians(15.0), abs=0.01
-                )
-    else:
-        sole_error = max(
-            float(np.linalg.norm(ik.sole_world(foot)[:3, 3] - target[:3, 3]))
-            for foot, target in zip(("left", "right"), _stance(width), strict=True)
-        )
-        height_error = abs(float(ik.com_world()[2]) - description.com_height)
-        assert sole_error > 0.005 or height_error > 0.01
-
-
-def _stance(width: float) -> tuple[np.ndarray, np.ndarray]:
-    return sole_pose(np.array([0.0, width / 2, 0.0])), sole_pose(np.array([0.0, -width / 2, 0.0]))
+    ik.reset(*stance(width), np.zeros(2))
+    while width < reach - 1e-9:
+        width += 0.005
+        assert holds(ik, description, width)
+    angles = dict(zip(ik.joint_names, ik.joint_angles(), strict=True))
+    for side in ("left", "right"):
+        assert abs(angles[f"{side}_ankle_roll_joint"]) == pytest.approx(np.radians(15.0), abs=0.01)
+    assert not holds(ik, description, reach + 0.02)
 
 
 def test_lateral_reach_rejects_a_bad_increment():
