@@ -95,6 +95,9 @@ class RobotDescription:
             3 values; the sole frame has the ankle link's orientation.
         sole: Sole contact rectangle (bounds the planner's ZMP window).
         com_height: Nominal CoM height above the ground while walking [m].
+        rotational_height: h_r, the body's centroidal angular momentum per unit
+            of CoM velocity over its mass [m] (L = m h_r H cdot as the CoM sways over
+            the feet); the planner's pendulum is c_z + h_r tall.
         foot_spacing: Nominal lateral distance between the two ankles [m].
         standing_posture: Joint name -> angle [rad] of the nominal posture; joints
             not listed are at 0 rad.
@@ -161,6 +164,7 @@ class RobotDescription:
     standing_posture: Mapping[str, float]
     joint_impedance: Mapping[str, JointImpedance]
     total_mass: float
+    rotational_height: float = 0.0
     fall_base_height: float = 0.4
     fall_tilt: float = math.radians(45.0)
     swing_height: float = 0.06
@@ -198,6 +202,8 @@ class RobotDescription:
             raise ParameterError("sole_offset", self.sole_offset, "(x, y, z<0) [m]")
         if not 0.2 <= self.com_height <= 2.0:
             raise ParameterError("com_height", self.com_height, "0.2 m <= c_z <= 2 m")
+        if not 0.0 <= self.rotational_height <= 0.5:
+            raise ParameterError("rotational_height", self.rotational_height, "0 <= h_r <= 0.5 m")
         if not 0.0 < self.foot_spacing < 1.0:
             raise ParameterError("foot_spacing", self.foot_spacing, "0 < L_y < 1 m")
         if not self.total_mass > 0.0:
@@ -243,6 +249,11 @@ class RobotDescription:
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
         object.__setattr__(self, "backend_options", MappingProxyType(dict(self.backend_options)))
         object.__setattr__(self, "joint_impedance", MappingProxyType(dict(self.joint_impedance)))
+
+    @property
+    def pendulum_height(self) -> float:
+        """c_z + h_r, the height of the planner's pendulum [m]."""
+        return self.com_height + self.rotational_height
 
     def ankle_link(self, foot: str) -> str:
         """Ankle link name of ``foot`` (``"left"`` or ``"right"``)."""

@@ -28,6 +28,9 @@ under position control, kept since):
   (``kinematics/reach.py``; the ankle rolls' +-15 deg end it). Development pushes with
   y +-0.4, 0.5, 0.55, 0.6 m: 93, 95, 97, 97 recovered; at 0.6 m the IK had no solution
   in some wide double supports (docs/notes/2026-12-04-lateral-reach.md).
+* ``rotational_height`` h_r 0.10 m: as the IK sways the CoM over the feet the body's
+  angular momentum follows the CoM velocity (h_r 0.104 m along x, 0.094 m along y,
+  ``kinematics/pendulum.py``), so the planner's LIPM is c_z + h_r = 0.76 m tall.
 * ``dcm_inset`` 0.02 m and |hdot| <= 5 N m: the planner's row (27c') and the bound
   on its feedback angular momentum rate.
 * ``physics_time_step`` 2 ms with 75 solver iterations: the motors' stable PD law
@@ -116,6 +119,7 @@ G1 = RobotDescription(
     sole_offset=(0.0, 0.0, -0.035),
     sole=SoleRectangle(x_min=-0.05, x_max=0.12, half_width=0.025),
     com_height=0.66,
+    rotational_height=0.10,
     foot_spacing=0.23,
     standing_posture=STANDING_POSTURE,
     joint_impedance={joint: _impedance(joint) for joint in _JOINTS},

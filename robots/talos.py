@@ -15,11 +15,14 @@ theta 0.01 s and a step reaction time of 0.2 s as on G1; 1 ms physics. Step boun
 the CoM midway at c_z, ``kinematics/reach.py``; development pushes with y +-0.53, 0.66,
 0.79, 0.87 m: 87, 88, 90, 90 recovered); x in [-0.33, 0.46] m, G1's in units of the CoM
 height (the LIPM's length scale, 0.87/0.66 = 1.32; docs/notes/2026-12-03-talos-reach.md,
-docs/notes/2026-12-04-lateral-reach.md). The whole-body stabilizer's defaults, chosen
-on G1, are used unchanged (its joint gains follow from each joint's effort limit); Talos
-lists no upper-body joints, so it has no flywheel and the whole hdot goes to the CoP (a
-flywheel of the torso and the shoulders did no better on the development pushes, and
-worse taking back the legs' momentum; docs/notes/2026-12-03-talos-reach.md).
+docs/notes/2026-12-04-lateral-reach.md). The planner's LIPM is c_z + h_r = 0.985 m tall:
+as the IK sways the CoM over the feet the body's angular momentum follows the CoM
+velocity with h_r 0.120 m along x, 0.115 m along y (``kinematics/pendulum.py``). The
+whole-body stabilizer's defaults, chosen on G1, are used unchanged (its joint gains
+follow from each joint's effort limit); Talos lists no upper-body joints, so it has no
+flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders
+did no better on the development pushes, and worse taking back the legs' momentum;
+docs/notes/2026-12-03-talos-reach.md).
 """
 
 from __future__ import annotations
@@ -79,6 +82,7 @@ TALOS = RobotDescription(
     sole_offset=(0.0, 0.0, -0.107),
     sole=SoleRectangle(x_min=-0.105, x_max=0.095, half_width=0.06),
     com_height=0.87,
+    rotational_height=0.115,
     foot_spacing=0.17,
     standing_posture=STANDING_POSTURE,
     joint_impedance={joint: _impedance(joint, effort) for joint, effort in _EFFORTS.items()},

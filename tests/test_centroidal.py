@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.stabilizer.centroidal import centre_of_pressure, contact_force, pivot
+from app.stabilizer.centroidal import centre_of_pressure, contact_force, pivot, sway_rate
 from planner.parameters import GRAVITY, LipmModel
 from robots import get_robot
 
@@ -60,6 +60,26 @@ def test_the_cop_moves_by_h_ldot_over_m_g_so_the_ground_turns_the_body_at_its_ld
         np.testing.assert_allclose(moment_about_com(cop, com, force), motion_rate, atol=1e-9)
         shift = np.linalg.norm(cop - r)
         assert shift == pytest.approx(np.linalg.norm(motion_rate) / (MODEL.mass * GRAVITY))
+
+
+def test_with_the_sway_left_out_of_the_cop_the_com_moves_as_a_pendulum_c_z_plus_h_r_tall():
+    """A body at c_z whose angular momentum follows its CoM velocity, L = m h_r H cdot,
+    plus any other motion's Ldot: the CoP for the pivot of a LIPM c_z + h_r tall, with
+    the sway's m h_r H cdd left out of it (the other Ldot kept), balances the moments
+    about the CoM with the body's whole Ldot, and the CoM accelerates as that taller
+    pendulum about the pivot."""
+    h_r = 0.1
+    tall = LipmModel(mass=MODEL.mass, com_height=MODEL.com_height + h_r)
+    for com, zmp, rate in cases():
+        r = pivot(zmp, rate, MODEL.mass)
+        force = contact_force(tall, com, r)
+        other = -rate[::-1]  # any Ldot of the rest of the motion
+        cdd = force[:2] / MODEL.mass
+        body_rate = MODEL.mass * h_r * np.array([-cdd[1], cdd[0]])  # d/dt of m h_r H cdot
+        np.testing.assert_allclose(sway_rate(force, h_r), body_rate)
+        cop = centre_of_pressure(r, other, MODEL.mass, np.zeros(2), SOLE, True)
+        np.testing.assert_allclose(moment_about_com(cop, com, force), body_rate + other, atol=1e-9)
+        np.testing.assert_allclose(force[:2], tall.mass * tall.omega**2 * (com - r))
 
 
 def test_the_net_force_is_the_lipms():

@@ -378,7 +378,8 @@ def description_field_cases() -> list[Case]:
     for name in ("stride_length", "step_width", "double_support_duration",
                  "single_support_duration", "angular_momentum_rate_max",
                  "lqr_dcm_error_scale", "swing_preparation_time", "filter_time_constant",
-                 "step_reaction_time", "reanchor_time", "com_height"):  # fmt: skip
+                 "step_reaction_time", "reanchor_time", "com_height",
+                 "rotational_height"):  # fmt: skip
         cases += [refused_value(name, value, robot="g1") for value in ("1e300", "-1e300")]
     for name in ("physics_time_step=0.001", "solver_iterations=10", "locked_joints=none",
                  "fall_tilt=0.5", "ground_friction=0.8", "swing_height=0.05",

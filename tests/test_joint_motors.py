@@ -168,7 +168,7 @@ def standing_errors(backend, feedforward: bool, seconds: float = 1.0):
         state = backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
         errors = []
         for step in range(round(seconds / backend.control_period)):
-            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.com_height)
+            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.description.pendulum_height)
             state = backend.step(command(step * backend.control_period, zmp), np.zeros(2))
             errors.append(backend.sim.measure().joint_positions - commands[-1].position)
             assert not backend.fall_status().fell

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from kinematics.pendulum import rotational_height
 from kinematics.reach import holds, lateral_reach, stance
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
 from kinematics.whole_body_ik import WholeBodyIK, sole_pose
@@ -209,3 +210,16 @@ def test_lateral_reach_rejects_a_bad_increment():
     with pytest.raises(ParameterError) as caught:
         lateral_reach(get_robot("g1"), increment=0.0)
     assert (caught.value.field, caught.value.value) == ("increment", 0.0)
+
+
+@pytest.mark.parametrize("robot", ["g1", "talos"])
+def test_each_robots_pendulum_is_as_tall_as_its_whole_body_motion_makes_it(robot):
+    """As the IK sways the CoM over fixed soles, the body's angular momentum follows the
+    CoM velocity, L = m h_r H cdot (kinematics/pendulum.py); the description's h_r, which
+    makes the planner's LIPM c_z + h_r tall, is within 1 cm of it along x and along y."""
+    description = get_robot(robot)
+    along_x, along_y = rotational_height(description)
+    assert along_x > 0.05 and along_y > 0.05, (along_x, along_y)  # the body does turn
+    for measured in (along_x, along_y):
+        assert abs(description.rotational_height - measured) <= 0.01, (robot, measured)
+    assert description.pendulum_height == description.com_height + description.rotational_height

@@ -224,7 +224,7 @@ def test_a_bad_override_is_caught_before_any_worker_or_folder(tmp_path: Path, ca
 
 
 def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
-    """``--model lipm --robot g1``: G1's mass, ZMP window and timing, with its
+    """``--model lipm --robot g1``: G1's mass, pendulum, ZMP window and timing, with its
     description fields settable and its backend options not."""
     from robots import get_robot
 
@@ -234,7 +234,7 @@ def test_a_robot_on_the_lipm_is_its_planner_on_the_point_mass() -> None:
     )
     assert backend.name == "lipm"
     assert config.model.mass == pytest.approx(g1.total_mass)
-    assert config.model.com_height == pytest.approx(g1.com_height)
+    assert config.model.com_height == pytest.approx(g1.com_height + g1.rotational_height)
     assert config.rsg.swing_preparation_time == pytest.approx(0.3)
     assert config.constraints.zmp_window_max[1] < g1.sole.half_width
     _, paper, _ = build_backend("lipm", None, "rsg")

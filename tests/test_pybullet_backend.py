@@ -40,7 +40,7 @@ def stand(backend, state, seconds, push=None, feedback=True):
         time = tick * backend.control_period
         zmp = np.zeros(2)
         if feedback:
-            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.com_height)
+            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.description.pendulum_height)
         force = push(time) if push else np.zeros(2)
         state = backend.step(command(time, zmp), force)
         if backend.fall_status().fell:
@@ -57,7 +57,8 @@ def total_cop(backend):
 
 def test_mass_in_pybullet_equals_the_urdf_mass(backend):
     assert backend.mass == pytest.approx(33.3, abs=0.1)
-    assert backend.com_height == pytest.approx(0.66)
+    assert backend.com_height == pytest.approx(0.66)  # drawn there; the planner's is taller
+    assert backend.description.pendulum_height == pytest.approx(0.66 + 0.10)
     # The controller's rigid-body model is the simulator's robot.
     assert backend.controller.mass == pytest.approx(backend.mass, abs=1e-6)
 
@@ -99,16 +100,16 @@ def test_under_a_constant_push_the_measured_cop_follows_the_planned_one(backend)
 
 @pytest.mark.parametrize("offset", [(0.01, 0.0), (0.0, 0.01)])
 def test_with_a_constant_zmp_the_com_diverges_as_the_lipm(backend, offset):
-    """The stabilizer realises the planner's pendulum: with the ZMP held at the origin
-    and the CoM starting 1 cm off it at rest, the LIPM gives c(t) = c0 cosh(omega t).
-    After 0.5 s (a factor 3.5) G1's CoM is there within 5 % of the offset's growth
-    (measured 3.4 % forward, 0.7 % sideways)."""
+    """The stabilizer realises the planner's pendulum, c_z + h_r tall: with the ZMP held
+    at the origin and the CoM starting 1 cm off it at rest, the LIPM gives
+    c(t) = c0 cosh(omega t). After 0.5 s (a factor 3.1) G1's CoM is there within 5 % of
+    the offset's growth (measured 3.5 % forward, 1.3 % sideways)."""
     offset = np.array(offset)
     axis = int(np.argmax(np.abs(offset)))
     state = backend.reset(InitialCondition(LEFT, RIGHT, offset, np.zeros(2)))
     state = stand(backend, state, 0.5, feedback=False)
     assert not backend.fall_status().fell
-    omega = np.sqrt(GRAVITY / backend.com_height)
+    omega = np.sqrt(GRAVITY / backend.description.pendulum_height)
     predicted = offset * np.cosh(omega * state.time)
     growth = predicted[axis] - offset[axis]
     assert abs(state.com_position[axis] - predicted[axis]) < 0.05 * growth
@@ -145,7 +146,7 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     for tick in range(round(0.8 / backend.control_period)):
         time = tick * backend.control_period
         target = np.array([0.08, -0.115]) if time < 0.3 else moved
-        zmp = dcm_feedback_zmp(state, over_left, backend.com_height)
+        zmp = dcm_feedback_zmp(state, over_left, backend.description.pendulum_height)
         out = command(time, zmp, next_step=Foothold("right", target), since_step=time)
         state = backend.step(out, np.zeros(2))
         assert not backend.fall_status().fell
@@ -154,7 +155,7 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     event = StepEvent(0.8, "right", landed.position, False, False)
     for tick in range(10):  # the double support after the step
         time = 0.8 + tick * backend.control_period
-        zmp = dcm_feedback_zmp(state, over_left, backend.com_height)
+        zmp = dcm_feedback_zmp(state, over_left, backend.description.pendulum_height)
         out = command(
             time,
             zmp,

@@ -168,7 +168,7 @@ def test_in_pybullet_the_waist_turns_with_a_pulse_of_hdot_and_comes_back():
         for tick in range(200):
             time = tick * backend.control_period
             rate = np.array([0.0, 3.0]) if 0.5 <= time < 0.7 else np.zeros(2)
-            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.com_height)
+            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.description.pendulum_height)
             out = command(time, zmp, angular_momentum_rate_feedback=rate)
             state = backend.step(out, np.zeros(2))
             pitches.append(backend.sim.joint_angles()["waist_pitch_joint"])  # stands at 0

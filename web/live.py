@@ -406,7 +406,7 @@ class LiveSimulation:
             time=time,
             com=measured.com_position.copy(),
             com_velocity=measured.com_velocity.copy(),
-            com_height=self._config.model.com_height,
+            com_height=loop.backend.com_height,
             omega=self._config.model.omega,
             zmp=np.array(out.zmp),
             window_center=np.array(out.window_center),

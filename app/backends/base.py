@@ -47,7 +47,7 @@ class Backend(Protocol):
     Attributes:
         name: Backend name written to the results (``"lipm"``, ``"pybullet"``).
         mass: Total mass m [kg] the planner should use.
-        com_height: CoM height c_z [m] the planner should use.
+        com_height: Nominal height of the CoM above the ground [m] (where it is drawn).
         control_period: Duration of one :meth:`step` [s].
     """
 

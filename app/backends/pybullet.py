@@ -86,7 +86,8 @@ class PyBulletBackend:
     Attributes:
         name: ``"pybullet"``.
         mass: Total mass measured in PyBullet [kg].
-        com_height: Nominal CoM height [m] (the planner's c_z).
+        com_height: Nominal CoM height [m] (the planner's pendulum is
+            ``description.pendulum_height``, taller).
         control_period: Duration of one :meth:`step` [s].
         controller: The whole-body controller.
         sim: The simulated robot.

@@ -55,6 +55,7 @@ Overrides = tuple[tuple[str, str], ...]
 #: (comma-separated names, or ``none``; not the URDF, links, sole or gains).
 DESCRIPTION_FIELDS = {
     "com_height": "float",
+    "rotational_height": "float",
     "foot_spacing": "float",
     "fall_base_height": "float",
     "fall_tilt": "float",

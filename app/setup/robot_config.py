@@ -29,7 +29,7 @@ def planner_config_for(
     sole = description.sole
     half_width = sole.half_width - ZMP_MARGIN
     return PlannerConfig(
-        model=LipmModel(mass=mass, com_height=description.com_height),
+        model=LipmModel(mass=mass, com_height=description.pendulum_height),
         gait=GaitParameters(
             stride_length=description.stride_length,
             step_width=description.step_width,

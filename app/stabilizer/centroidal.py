@@ -18,6 +18,13 @@ keeps it in the hull of the two soles. Ldot is that of the whole-body motion the
 plans (legs and the upper-body flywheel, :mod:`kinematics.upper_body`), so the
 flywheel's share of hdot takes load off the CoP. (Popovic, Goswami and Herr, "Ground
 reference points in legged locomotion", IJRR 2005, for the CMP.)
+
+Part of Ldot is the body's sway: as the CoM moves over the feet the legs turn and
+L = m h_r H cdot (:mod:`kinematics.pendulum`), so Ldot = m h_r H cdd. With that part in
+the CoP, the CoM moves as a pendulum c_z + h_r tall about the CoP; the planner's LIPM is
+that tall (``RobotDescription.pendulum_height``), so the sway's share is left out of the
+CoP (:func:`sway_rate`): a CoP on the sole's edge then stops the CoM as the planner
+expects, where a LIPM at c_z would expect more than the robot can do.
 """
 
 from __future__ import annotations
@@ -62,3 +69,9 @@ def contact_force(
     """Net ground force [N], shape (3,): the LIPM's m omega^2 (c - r) and m g."""
     horizontal = model.mass * model.omega**2 * (np.asarray(com, float) - pivot_point)
     return np.array([horizontal[0], horizontal[1], model.mass * model.gravity])
+
+
+def sway_rate(force: NDArray[np.float64], rotational_height: float) -> NDArray[np.float64]:
+    """Angular momentum rate of the body's sway, m h_r H cdd = h_r H f [N m], shape (2,),
+    for the net ground ``force`` [N] and h_r ``rotational_height`` [m]."""
+    return rotational_height * (H_MATRIX @ np.asarray(force, float)[:2])

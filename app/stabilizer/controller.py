@@ -72,7 +72,7 @@ class WholeBodyController:
         self.period = control_period
         self.model = RobotModel(description)
         self.mass = self.model.mass
-        self.lipm = LipmModel(mass=self.mass, com_height=description.com_height)
+        self.lipm = LipmModel(mass=self.mass, com_height=description.pendulum_height)
         self.estimator = StateEstimator(self.model, config.estimator)
         flywheel = config.flywheel_momentum > 0.0 and bool(description.upper_body_joints)
         self.ik = WholeBodyIK(description, upper_body=flywheel)
@@ -152,15 +152,16 @@ class WholeBodyController:
             self._start_swing(stance, swing)
         # stabilize
         pivot = centroidal.pivot(command.zmp, command.angular_momentum_rate, self.mass)
+        force = centroidal.contact_force(self.lipm, state.com[:2], pivot)
+        sway = centroidal.sway_rate(force, self.description.rotational_height)
         self.planned_cop = centroidal.centre_of_pressure(
             pivot,
-            self._motion_momentum_rate,
+            self._motion_momentum_rate - sway,
             self.mass,
             np.asarray(command.stance.position, float),
             self.description.sole,
             command.double_support,
         )
-        force = centroidal.contact_force(self.lipm, state.com[:2], pivot)
         com_target, _ = integrate_lipm(
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
