@@ -1,4 +1,5 @@
-"""The live simulation thread of the browser demo, on the fast LIPM backend."""
+"""The live simulation thread of the browser demo, on the fast LIPM backend (and where
+the G1 page draws its CoM)."""
 
 from __future__ import annotations
 
@@ -145,3 +146,32 @@ def test_the_live_loop_keeps_bounded_memory_however_long_it_runs():
     assert sizes[0][4:] == sizes[1][4:] == (1000, 200), sizes  # plot and trail windows
     assert sizes[1][3] <= STEP_MARKS
     live.stop()
+
+
+@pytest.mark.usefixtures("cache_in_tmp")
+def test_the_g1_page_draws_the_com_where_the_robot_carries_it():
+    """The planner's pendulum is taller than G1's CoM (c_z + h_r, robots/g1.py): the
+    page still draws the CoM marker at the CoM of the robot it draws, computed from the
+    same snapshot's pose, within 2 cm (10 cm higher if drawn at the pendulum)."""
+    import numpy as np
+
+    from kinematics.robot_model import RobotModel
+    from robots import get_robot
+    from web.scene_model import draw_scene
+
+    live = LiveSimulation("pybullet", "g1", "rsg", "walk", log=lambda _: None)
+    live.start()
+    try:
+        assert wait_for(lambda: live.snapshot().status.time > 1.0, timeout=120.0)
+        snap = live.snapshot()
+    finally:
+        live.stop()
+    assert snap.state is not None and snap.robot is not None
+    drawing = draw_scene(snap.state, snap.foot_lower, snap.foot_upper)
+    model = RobotModel(get_robot("g1"))
+    pose = snap.robot
+    w, x, y, z = pose.base_wxyz
+    joints = [pose.joints[name] for name in model.joint_names]
+    model.update(np.array([*pose.base_position, x, y, z, w, *joints]), np.zeros(model.nv))
+    assert abs(drawing.com[2] - model.com[2]) < 0.02, (drawing.com, model.com)
+    np.testing.assert_allclose(drawing.com[:2], model.com[:2], atol=0.01)
