@@ -4,7 +4,8 @@ With its feet on the ground, a biped moves its CoM by turning its legs: the body
 the CoM then moves faster than the legs below it, and its centroidal angular momentum
 follows the CoM velocity, L = m h_r H cdot (H of (1)). Its rate m h_r H cddot moves the
 pivot by h_r cddot / g, so the CoM moves as a point-mass pendulum c_z + h_r tall, not
-c_z: slower to stop on a sole's edge than the planner's LIPM at c_z would be. (Lee and
+c_z: slower to stop on a sole's edge than a LIPM at c_z would be; the planner's LIPM on a
+robot is that tall (``RobotDescription.pendulum_height``). (Lee and
 Goswami, "Reaction mass pendulum (RMP): an explicit model for centroidal angular
 momentum of humanoid robots", ICRA 2007, for a body whose inertia turns with the
 pendulum.)
