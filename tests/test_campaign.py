@@ -152,6 +152,31 @@ def test_the_twin_of_a_push_is_a_direct_lipm_run_of_it(tmp_path: Path) -> None:
     assert record["final_lyapunov"] == pytest.approx(direct["final_lyapunov"], rel=1e-3)
 
 
+def test_the_stance_offset_is_how_far_the_twin_swings_its_com_over_the_stance_sole() -> None:
+    """G1's twin, 9 N s early in the left single support: pushed toward the stance side
+    (90 deg), its CoM swings far over the left sole before the crossing-free steps catch
+    it; pushed forward (0 deg) it stays about as far to the side as in the walk. The
+    record holds the largest |c_y - p_y| of the run's single supports after the push."""
+    spec = CampaignSpec(model="lipm", robot="g1", controllers=("rsg",), settle=4.0)
+    config = gait_config("g1", False, ())
+    touchdown = touchdowns(spec)["robot|rsg"]
+    offsets = {}
+    for direction in (0.0, 90.0):
+        push = CampaignPush(0, direction, phase=0.05, delay=0.04, impulse=9.0, duration=0.06)
+        record = run_campaign_job(spec, push, CampaignJob(0, "rsg"), touchdown)
+        assert record["outcome"] == "recovered"
+        pushed = push.push(touchdown)
+        result = PushRun(spec, "rsg").run(pushed, pushed.time + spec.settle)
+        single = result.column("time_since_step") >= config.gait.double_support_duration
+        after = single & (result.column("t") >= pushed.time)
+        lateral = np.abs(result.column("com_y") - result.column("foot_y"))[after]
+        assert record["stance_offset_y"] == pytest.approx(lateral.max())
+        offsets[direction] = record["stance_offset_y"]
+    half_width = config.gait.step_width / 2
+    assert offsets[0.0] < half_width + 0.03
+    assert offsets[90.0] > half_width + 0.1
+
+
 def test_interrupted_campaign_resumes_and_skips_finished_runs(tmp_path: Path, monkeypatch) -> None:
     spec = replace(QUICK, controllers=("rsg", "no-step"))
     real = campaign_module.run_campaign_job

@@ -44,7 +44,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from app.experiments.jobs import JobRun, run_resumable
-from app.experiments.outcome import PushRun, describe, impulse_along
+from app.experiments.outcome import PushRun, describe, impulse_along, stance_offset_after
 from app.experiments.sweep import PLACO_WPG, PushExperiment, check_pushes
 from app.scenarios import MAX_IMPULSE
 from app.setup.build import build_backend
@@ -293,6 +293,9 @@ def run_campaign_job(
         "touchdown": touchdown,
         "push_time": pushed.time,
         **describe(result, pushed, job.controller),
+        "stance_offset_y": (
+            None if job.controller == PLACO_WPG else stance_offset_after(result, pushed.time)
+        ),
         "wall_time": time.perf_counter() - started,
     }
 

@@ -12,7 +12,8 @@ from app.experiments.campaign import CampaignJob, CampaignPush, CampaignSpec, se
 from app.experiments.outcome import OUTCOMES, RECOVERED_MEANS
 from planner.exceptions import RsgError
 
-FIGURES = ("push_time", "outcome", "fall_reason", "adjusted_steps", "settle_steps")
+FIGURES = ("push_time", "outcome", "fall_reason", "adjusted_steps", "settle_steps",
+           "stance_offset_y")  # fmt: skip
 DEFINITIONS = {
     "phase": "fraction of the gait cycle T^* since the touchdown of step `cycle` in the "
     "unpushed walk (double support below T_DSP / T^*)",
@@ -24,6 +25,9 @@ DEFINITIONS = {
     "adjusted_steps": "adjusted steps landing at or after the push start",
     "settle_steps": "touchdowns from the push start up to the last instant with V_u >= "
     "gamma_v (0: V_u stayed below; null: V_u not below gamma_v for good by the end)",
+    "stance_offset_y": "largest lateral (world y) distance between the CoM and the stance "
+    "sole in single support after the push start [m] (null for placo-wpg): on the twin, "
+    "how far the plan swings the CoM over the stance leg",
     "twin": "the same push on the LIPM with the robot's planner (--model lipm --robot NAME)",
     "adjusted_step_ratio": "sum of the robot's adjusted steps / the twin's, over all pushes "
     "(_both: over the pushes both recovered)",
@@ -57,7 +61,7 @@ def push_rows(spec: CampaignSpec, pushes: list[CampaignPush], records: dict[str,
 
 def _figures(records: dict[str, dict], job: CampaignJob) -> dict:
     record = records[job.key]
-    return {name: record[name] for name in FIGURES}
+    return {name: record.get(name) for name in FIGURES}  # folders of earlier versions lack some
 
 
 def summarize(spec: CampaignSpec, rows: list[dict]) -> dict:
@@ -117,6 +121,7 @@ def write_campaign(
             "impulse": "N s",
             "duration": "s",
             "velocity_change": "m/s",
+            "stance_offset_y": "m",
             "mass": "kg",
         },
         "definitions": DEFINITIONS,

@@ -118,6 +118,19 @@ def describe(result: RunResult, push: Push, controller: str) -> dict:
     }
 
 
+def stance_offset_after(result: RunResult, push_time: float) -> float | None:
+    """Largest lateral (world y) distance [m] between the CoM and the stance sole in
+    single support from ``push_time`` on: how far the plan swings the CoM over the
+    stance leg (None without such a tick)."""
+    time = result.column("t")
+    single = result.column("time_since_step") >= result.config.gait.double_support_duration
+    after = single & (time >= push_time)
+    if not after.any():
+        return None
+    offset = np.abs(result.column("com_y") - result.column("foot_y"))
+    return float(offset[after].max())
+
+
 def impulse_along(direction_deg: float, magnitude: float) -> np.ndarray:
     """Impulse vector [N s] of ``magnitude`` along ``direction_deg`` (0 forward, 90 left)."""
     angle = np.radians(direction_deg)
