@@ -26,7 +26,7 @@ from robots.description import RobotDescription
 AMPLITUDE = 0.02  # [m] of the CoM's sway
 PERIOD = 0.5  # [s] of the CoM's sway
 DT = 0.01  # [s] between IK solves
-CYCLES = 2
+CYCLES = 2  # sway periods the least-squares slope is fitted over
 
 
 def rotational_height(description: RobotDescription) -> tuple[float, float]:
