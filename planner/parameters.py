@@ -266,6 +266,10 @@ class RsgParameters:
             or a decision kept through ``step_reaction_time``); False (the paper):
             below gamma_v H_nu steps 2 xi1*; with a reaction time the announced
             foothold then moves between the QP's and 2 xi1* as V_u crosses gamma_v.
+        announced_foothold: An extension of the output map H_nu: a nominal jump (D_S)
+            steps onto the foothold announced at the tick before, where a real swing
+            foot was sent and has touched down by then; False (the paper): H_nu at the
+            jump's own state.
     """
 
     filter_time_constant: float = 0.05
@@ -283,15 +287,21 @@ class RsgParameters:
     reanchor_time: float = 0.0
     dcm_inset: float | None = None
     qp_at_timing_jump: bool = True
+    announced_foothold: bool = True
 
     def __post_init__(self) -> None:
-        if not isinstance(self.qp_at_timing_jump, bool):
-            raise ParameterError("qp_at_timing_jump", self.qp_at_timing_jump, "True or False")
+        for flag in ("qp_at_timing_jump", "announced_foothold"):
+            if not isinstance(getattr(self, flag), bool):
+                raise ParameterError(flag, getattr(self, flag), "True or False")
         if self.dcm_inset is not None:
             _check_ranges(self, "dcm_inset")
         _check_ranges(
             self,
-            *(f.name for f in fields(self) if f.name not in ("dcm_inset", "qp_at_timing_jump")),
+            *(
+                f.name
+                for f in fields(self)
+                if f.name not in ("dcm_inset", "qp_at_timing_jump", "announced_foothold")
+            ),
         )
 
 

@@ -31,6 +31,8 @@ Departures and extensions, one line each (why, flag and measurement:
   touchdown at min(max(s~ + Delta, T_DSP + T_SP), s~_nom), the QP solved at the state
   predicted then; the decision is kept;
 - ``qp_at_timing_jump``: H_nu takes the QP's step for a timing jump even below gamma_v;
+- ``announced_foothold``: a nominal jump (D_S) steps onto the foothold announced at the
+  tick before, where the swing foot was sent, as a scheduled timing jump does;
 - a backend's swing contact (``MeasuredState.swing_contact``: a due jump waits for the
   swing sole to touch down, its foothold kept) and stance sole
   (``MeasuredState.stance_sole``: o_H follows it, over ``reanchor_time``).
@@ -116,6 +118,8 @@ class ReactiveStepGenerator:
         self.compensation_state = np.zeros(2)  # filtered m g H^-1 r~_H [N m]
         self.scheduled_step: float | None = None  # s~ of a decided timing jump
         self.announced_step: np.ndarray | None = None  # its foothold, last announced [m]
+        # The next step of the last output [m], and whether the QP (27) placed it.
+        self.last_next_step: tuple[np.ndarray, bool] | None = None
         self.held_step: HeldStep | None = None  # a due jump waiting for the touchdown
         self.reference = ReferenceModel(self.orbit, self.sigma, s0)
         self._last_dcm: np.ndarray | None = None  # measured DCM at the last tick (world)
@@ -259,6 +263,10 @@ class ReactiveStepGenerator:
         if timing and self.announced_step is not None:
             # The swing foot was sent to the foothold announced last tick: it lands there.
             return self.announced_step - self.stance, True, True
+        if not timing and self.last_next_step is not None and self.config.rsg.announced_foothold:
+            # So was a nominal step's, whose sole is on the ground by now.
+            foothold, from_qp = self.last_next_step
+            return foothold - self.stance, from_qp, True
         return self._step_location(xi, error, level, self.qp_solver)
 
     def _nominal_wait(self) -> float:
@@ -273,7 +281,18 @@ class ReactiveStepGenerator:
         nominal_wait: float | None = None,
         error: np.ndarray | None = None,
     ) -> np.ndarray:
-        """Where the next step would land [m], re-planned at each tick.
+        """Where the next step would land [m], re-planned at each tick (see
+        :meth:`_preview`)."""
+        return self._preview(xi, nominal_wait, error)[0]
+
+    def _preview(
+        self,
+        xi: np.ndarray,
+        nominal_wait: float | None = None,
+        error: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, bool]:
+        """Where the next step would land [m], re-planned at each tick, and whether the
+        QP (27) places it.
 
         With a jump held for the touchdown it is that jump's foothold; with a timing
         jump scheduled it is the QP (27) at the state predicted at its touchdown; with
@@ -286,22 +305,22 @@ class ReactiveStepGenerator:
             error: e_u of ``xi``, if already known [m].
         """
         if self.held_step is not None:
-            return self.held_step.foothold.copy()
+            return self.held_step.foothold.copy(), self.held_step.from_qp
         error = self.dcm_error(xi) if error is None else error
         level = self.design.level(error)
         if self.scheduled_step is not None and self.config.adjusts_location:
             delay = self.scheduled_step - self.time_since_step
             predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
-            step, _, _ = self._step_location(
+            step, from_qp, _ = self._step_location(
                 predicted, predicted_error, level, "exact", reference_xi1
             )
-            return self.stance + step
+            return self.stance + step, from_qp
         if self.config.adjusts_location and level >= self.design.threshold:
             step, _, _ = self._step_location(xi, error, level, "exact")
-            return self.stance + step
+            return self.stance + step, True
         wait = self._nominal_wait() if nominal_wait is None else nominal_wait
         future = flow_autonomous(self.omega, self.reference.state, wait)
-        return self.stance + 2.0 * future[:2]
+        return self.stance + 2.0 * future[:2], False
 
     def predicted_step_time(
         self, time: float, level: float, nominal_wait: float | None = None
@@ -392,6 +411,7 @@ class ReactiveStepGenerator:
         window_offset = self.window_offset()
         zmp_offset = self.filter_state[:2].copy()
         angular_momentum_rate = self.filter_state[2:] + self.compensation_state
+        next_step, next_from_qp = self._preview(xi, nominal_wait, error)
         output = PlannerOutput(
             time=measured.time,
             zmp=self.stance + zmp_offset + window_offset,
@@ -401,7 +421,7 @@ class ReactiveStepGenerator:
             angular_momentum_rate_feedback=self.filter_state[2:].copy(),
             stance=Foothold(_foot_of(self.sigma), self.stance.copy()),
             previous_stance=Foothold(_foot_of(-self.sigma), self.previous.copy()),
-            next_step=Foothold(_foot_of(-self.sigma), self.preview_step(xi, nominal_wait, error)),
+            next_step=Foothold(_foot_of(-self.sigma), next_step),
             next_step_time=self.predicted_step_time(measured.time, level, nominal_wait),
             time_since_step=self.time_since_step,
             double_support=self._in_double_support(),
@@ -419,6 +439,7 @@ class ReactiveStepGenerator:
         # The swing foot is sent to the announced foothold: a scheduled step lands there.
         scheduled = self.scheduled_step is not None
         self.announced_step = output.next_step.position.copy() if scheduled else None
+        self.last_next_step = (output.next_step.position.copy(), next_from_qp)
         self._flow(error, window_offset, period)
         return output
 

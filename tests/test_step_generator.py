@@ -193,6 +193,48 @@ def test_jump_19b_and_nominal_location():
     np.testing.assert_allclose(out.dcm_error, error_before - u_d + 2 * reference_xi1, atol=1e-9)
 
 
+def _nominal_jump(config: PlannerConfig, kick_at: int | None):
+    """Ticks of 1 ms up to a nominal jump from 10 ms before it, the measured CoM velocity
+    kicked at tick ``kick_at``; the jump's output, its tick and the next step the tick
+    before announced."""
+    gen = ReactiveStepGenerator(config)
+    gen.reset(
+        Foothold("left", np.array([0.0, 0.1])),
+        Foothold("right", np.array([-0.2, -0.1])),
+        time_since_step=0.79,
+    )
+    com, velocity = gen.initial_com_state()
+    dt, announced = 0.001, None
+    for k in range(40):
+        kick = np.array([0.2, -0.1]) if k == kick_at else np.zeros(2)  # [m/s]
+        out = gen.update(MeasuredState(k * dt, com, velocity + kick), dt)
+        if out.step is not None:
+            return out, k, announced
+        announced = out.next_step.position.copy()
+        com = com + velocity * dt
+    raise AssertionError("no step within 40 ms")
+
+
+def test_a_nominal_step_lands_where_the_swing_foot_was_sent():
+    """A DCM error above gamma_v that shows only at the tick of a nominal jump (D_S), as
+    a robot's touchdown makes it: with ``announced_foothold`` the step is the foothold
+    announced at the tick before (2 xi1*, not adjusted); the paper's H_nu (False) puts it
+    where the QP (27) says at the jump's own state."""
+    for flag in (True, False):
+        config = PlannerConfig()
+        config = replace(config, rsg=replace(config.rsg, announced_foothold=flag))
+        _, tick, _ = _nominal_jump(config, None)
+        out, kicked_tick, announced = _nominal_jump(config, tick)
+        assert kicked_tick == tick
+        assert out.step.lyapunov_before > config.rsg.lyapunov_threshold
+        if flag:
+            np.testing.assert_allclose(out.stance.position, announced, atol=1e-12)
+            assert not out.step.adjusted
+        else:
+            assert np.linalg.norm(out.stance.position - announced) > 0.005
+            assert out.step.location_adjusted
+
+
 def test_same_run_twice_is_identical(fig6_runs):
     again = run_lipm("rsg", FIG6)
     np.testing.assert_array_equal(again.timeseries, fig6_runs["rsg"].timeseries)
