@@ -275,16 +275,6 @@ class ReactiveStepGenerator:
         wait = max(self.reference.time_to_nominal_jump(), ready, 0.0)
         return wait if math.isfinite(wait) else max(ready, 0.0)
 
-    def preview_step(
-        self,
-        xi: np.ndarray,
-        nominal_wait: float | None = None,
-        error: np.ndarray | None = None,
-    ) -> np.ndarray:
-        """Where the next step would land [m], re-planned at each tick (see
-        :meth:`_preview`)."""
-        return self._preview(xi, nominal_wait, error)[0]
-
     def _preview(
         self,
         xi: np.ndarray,

@@ -10,7 +10,10 @@ import numpy as np
 import pytest
 
 from app.cli import main
+from app.results.folder import ResultFolderError
+from app.results.replay import ReplayError
 from app.scenarios import load_scenario, parse_push
+from app.stabilizer.wrench_distribution import WrenchDistributionError
 from kinematics.whole_body_ik import IkInfeasibleError
 from planner.exceptions import ParameterError, StepQpError
 from planner.parameters import Constraints, GaitParameters, LipmModel, PlannerConfig, RsgParameters
@@ -172,6 +175,9 @@ def test_rsg_run_writes_summary_timeseries_and_plots(tmp_path):
         ParameterError("impulses", (-1.0,), "impulses in (0, 1000] N s"),
         StepQpError("no step meets (27b)-(27d)", {"target": [0.1, 0.2]}),
         IkInfeasibleError("left", np.array([0.1, 0.2]), "hard tasks"),
+        WrenchDistributionError(2, np.array([1.0, 2.0, 330.0]), np.array([0.1, 0.0])),
+        ReplayError(Path("runs/a"), "no replay.npz"),
+        ResultFolderError(Path("runs/a"), "holds a sweep", "use --overwrite"),
     ],
 )
 def test_project_errors_keep_their_data_across_processes(error):

@@ -183,6 +183,25 @@ def test_an_unreachable_stance_foot_is_a_fall_not_a_crash(backend):
     assert not backend.fall_status().fell
 
 
+def test_a_wrench_distribution_without_solution_is_a_fall_not_a_crash(backend, monkeypatch):
+    """If the distribution QP finds no wrenches (seen only with the robot thrown about
+    by a push far beyond what it recovers), the backend reports a fall with the reason."""
+    from app.stabilizer import controller
+    from app.stabilizer.wrench_distribution import WrenchDistributionError
+
+    def no_solution(contacts, force, cop, limits):
+        raise WrenchDistributionError(len(contacts), force, cop)
+
+    backend.reset(STANDING)
+    monkeypatch.setattr(controller, "distribute_wrench", no_solution)
+    backend.step(command(0.0, np.zeros(2)), np.zeros(2))
+    status = backend.fall_status()
+    assert status.fell and "wrench distribution" in status.reason, status
+    monkeypatch.undo()
+    backend.reset(STANDING)
+    assert not backend.fall_status().fell
+
+
 def test_ik_infeasibility_is_a_project_error_with_its_data():
     from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 

@@ -208,9 +208,10 @@ class PyBulletBackend:
     # ---------------------------------------------------------------- queries
     def fall_status(self) -> FallStatus:
         """Fallen if the pelvis is low or tilted, a non-foot body touches the ground, or
-        the whole-body IK had no solution."""
-        if self.controller.ik_failure is not None:
-            return FallStatus(True, self.controller.ik_failure)
+        the controller could not command the joints (the whole-body IK or the wrench
+        distribution had no solution)."""
+        if self.controller.failure is not None:
+            return FallStatus(True, self.controller.failure)
         position, quaternion = self.sim.base_pose()
         if position[2] < self.description.fall_base_height:
             return FallStatus(True, f"pelvis height {position[2]:.3f} m")

@@ -71,6 +71,9 @@ class ReplayError(RsgError):
         self.reason = reason
         super().__init__(f"{path}: {reason}")
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.path, self.reason))
+
 
 class ReplayRecorder:
     """Samples the closed loop for a replay; pass it as ``on_tick`` to

@@ -24,7 +24,12 @@ from app.stabilizer import centroidal
 from app.stabilizer.config import StabilizerConfig
 from app.stabilizer.estimator import RobotState, StateEstimator
 from app.stabilizer.landing import Landing
-from app.stabilizer.wrench_distribution import ContactLimits, FootContact, distribute_wrench
+from app.stabilizer.wrench_distribution import (
+    ContactLimits,
+    FootContact,
+    WrenchDistributionError,
+    distribute_wrench,
+)
 from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
 from kinematics.upper_body import UpperBodyFlywheel
@@ -57,7 +62,8 @@ class WholeBodyController:
         expected_contact_force: J^T f of the contact wrenches planned at the last
             tick [N, N m] (what the feed-forward torques are computed for).
         planned_cop: The CoP the feet were asked for at the last tick [m].
-        ik_failure: Why the IK had no solution, once it had none.
+        failure: Why the controller could not command the joints (the IK or the
+            wrench distribution had no solution), once it could not.
     """
 
     def __init__(
@@ -117,7 +123,7 @@ class WholeBodyController:
         self._motion_momentum_rate = np.zeros(2)
         self._stance_yaw = 0.0
         self.planned_cop = np.array(com_xy, dtype=float)
-        self.ik_failure: str | None = None
+        self.failure: str | None = None
         self._contacts: list[FootContact] = []
 
     def reset(
@@ -228,9 +234,7 @@ class WholeBodyController:
             )[self._ik_order]
         except IkInfeasibleError as error:
             # Seen only while falling: hold the last targets and report the fall.
-            self.ik_failure = (
-                f"whole-body IK infeasible at t = {command.time:.2f} s ({error.reason})"
-            )
+            self.failure = f"whole-body IK infeasible at t = {command.time:.2f} s ({error.reason})"
             q = self._targets[0]
         momentum = self.ik.angular_momentum[:2].copy()
         previous = momentum if self._ik_momentum is None else self._ik_momentum
@@ -260,7 +264,12 @@ class WholeBodyController:
             yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
             ground_point = np.array([position[0], position[1], 0.0])
             contacts.append(FootContact(ground_point, yaw, self._ankle_height))
-        wrenches = distribute_wrench(contacts, force, self.planned_cop, self.limits)
+        try:
+            wrenches = distribute_wrench(contacts, force, self.planned_cop, self.limits)
+        except WrenchDistributionError as error:
+            # Seen only while falling: no contact wrenches in the feed-forward; report it.
+            self.failure = f"{error} at t = {command.time:.2f} s"
+            wrenches = [np.zeros(6) for _ in contacts]
         self._contacts = contacts
         return feet, wrenches
 

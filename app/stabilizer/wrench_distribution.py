@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -84,6 +85,10 @@ class WrenchDistributionError(RsgError):
             f"(force {np.round(force, 1)} N, CoP {np.round(cop, 3)} m)"
         )
         self.feet, self.force, self.cop = feet, force, cop
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Rebuilt from its data, so it crosses process boundaries (sweep and grid workers).
+        return (type(self), (self.feet, self.force, self.cop))
 
 
 def _skew(v: NDArray[np.float64]) -> NDArray[np.float64]:
