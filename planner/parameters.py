@@ -232,6 +232,9 @@ class Constraints:
         return np.array([*self.zmp_window_max, h, h])
 
 
+_RSG_FLAGS = ("qp_at_timing_jump", "announced_foothold")  # True/False options of RsgParameters
+
+
 @dataclass(frozen=True)
 class RsgParameters:
     """Design parameters of the hybrid tracking controller (Section V, VI).
@@ -290,18 +293,14 @@ class RsgParameters:
     announced_foothold: bool = True
 
     def __post_init__(self) -> None:
-        for flag in ("qp_at_timing_jump", "announced_foothold"):
+        for flag in _RSG_FLAGS:
             if not isinstance(getattr(self, flag), bool):
                 raise ParameterError(flag, getattr(self, flag), "True or False")
         if self.dcm_inset is not None:
             _check_ranges(self, "dcm_inset")
         _check_ranges(
             self,
-            *(
-                f.name
-                for f in fields(self)
-                if f.name not in ("dcm_inset", "qp_at_timing_jump", "announced_foothold")
-            ),
+            *(f.name for f in fields(self) if f.name not in ("dcm_inset", *_RSG_FLAGS)),
         )
 
 

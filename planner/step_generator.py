@@ -117,9 +117,9 @@ class ReactiveStepGenerator:
         self.filter_state = np.zeros(4)  # zeta = filtered sat(K_u e_u) = (p~, hdot_fb)
         self.compensation_state = np.zeros(2)  # filtered m g H^-1 r~_H [N m]
         self.scheduled_step: float | None = None  # s~ of a decided timing jump
-        self.announced_step: np.ndarray | None = None  # its foothold, last announced [m]
-        # The next step of the last output [m], and whether the QP (27) placed it.
-        self.last_next_step: tuple[np.ndarray, bool] | None = None
+        # The last output's next step [m], whether the QP (27) placed it, and whether it
+        # was a scheduled timing jump's: where the swing foot was sent.
+        self.announced: tuple[np.ndarray, bool, bool] | None = None
         self.held_step: HeldStep | None = None  # a due jump waiting for the touchdown
         self.reference = ReferenceModel(self.orbit, self.sigma, s0)
         self._last_dcm: np.ndarray | None = None  # measured DCM at the last tick (world)
@@ -260,13 +260,14 @@ class ReactiveStepGenerator:
         self, timing: bool, xi: np.ndarray, error: np.ndarray, level: float
     ) -> tuple[np.ndarray, bool, bool]:
         """u_d of a jump due now; returns (u_d, from_qp, qp_feasible)."""
-        if timing and self.announced_step is not None:
-            # The swing foot was sent to the foothold announced last tick: it lands there.
-            return self.announced_step - self.stance, True, True
-        if not timing and self.last_next_step is not None and self.config.rsg.announced_foothold:
-            # So was a nominal step's, whose sole is on the ground by now.
-            foothold, from_qp = self.last_next_step
-            return foothold - self.stance, from_qp, True
+        if self.announced is not None:
+            # The swing foot was sent to the foothold announced last tick: it lands there
+            # (a nominal step's sole is on the ground by now).
+            foothold, from_qp, scheduled = self.announced
+            if timing and scheduled:
+                return foothold - self.stance, True, True
+            if not timing and self.config.rsg.announced_foothold:
+                return foothold - self.stance, from_qp, True
         return self._step_location(xi, error, level, self.qp_solver)
 
     def _nominal_wait(self) -> float:
@@ -426,10 +427,9 @@ class ReactiveStepGenerator:
             self.model.mass * self.model.gravity
         )
         self._last_period = period
-        # The swing foot is sent to the announced foothold: a scheduled step lands there.
+        # The swing foot is sent to the announced foothold: the next step lands there.
         scheduled = self.scheduled_step is not None
-        self.announced_step = output.next_step.position.copy() if scheduled else None
-        self.last_next_step = (output.next_step.position.copy(), next_from_qp)
+        self.announced = (output.next_step.position.copy(), next_from_qp, scheduled)
         self._flow(error, window_offset, period)
         return output
 

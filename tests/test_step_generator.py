@@ -95,15 +95,22 @@ def test_post_step_level_decreases_in_case_a(scenario):
         assert len(checked) >= 2 and checked[0] >= gamma, checked
 
 
-def _generator_at(config, time_since_step, error, lateral=None):
-    """A generator on the left foot at s~ = ``time_since_step`` and the measured state
-    with DCM error ``error`` [m] (and the CoM ``lateral`` [m] left of the ankle)."""
-    gen = ReactiveStepGenerator(config, qp_solver="exact")
+def _on_left_foot(config, time_since_step, qp_solver="proxqp"):
+    """A generator standing on the left foot (the right one behind) at s~ =
+    ``time_since_step`` [s]."""
+    gen = ReactiveStepGenerator(config, qp_solver=qp_solver)
     gen.reset(
         Foothold("left", np.array([0.0, 0.1])),
         Foothold("right", np.array([-0.2, -0.1])),
         time_since_step=time_since_step,
     )
+    return gen
+
+
+def _generator_at(config, time_since_step, error, lateral=None):
+    """A generator on the left foot at s~ = ``time_since_step`` and the measured state
+    with DCM error ``error`` [m] (and the CoM ``lateral`` [m] left of the ankle)."""
+    gen = _on_left_foot(config, time_since_step, qp_solver="exact")
     com_offset = gen.reference.xi1.copy()
     if lateral is not None:
         com_offset[1] = lateral
@@ -163,12 +170,7 @@ def test_dt2_steps_when_the_com_passes_the_outer_edge_with_hnu_2xi1_below_gamma(
 def test_jump_19b_and_nominal_location():
     """At each step e_u^+ = e_u - u_d + 2 xi1*; u_d = 2 xi1* when V_u < gamma_v."""
     config = PlannerConfig()
-    gen = ReactiveStepGenerator(config)
-    gen.reset(
-        Foothold("left", np.array([0.0, 0.1])),
-        Foothold("right", np.array([-0.2, -0.1])),
-        time_since_step=0.79,
-    )
+    gen = _on_left_foot(config, 0.79)
     com, velocity = gen.initial_com_state()
     velocity = velocity + np.array([0.004, -0.002])  # a small DCM error, V_u < gamma_v
     xi = np.r_[com - gen.stance, velocity]
@@ -197,12 +199,7 @@ def _nominal_jump(config: PlannerConfig, kick_at: int | None):
     """Ticks of 1 ms up to a nominal jump from 10 ms before it, the measured CoM velocity
     kicked at tick ``kick_at``; the jump's output, its tick and the next step the tick
     before announced."""
-    gen = ReactiveStepGenerator(config)
-    gen.reset(
-        Foothold("left", np.array([0.0, 0.1])),
-        Foothold("right", np.array([-0.2, -0.1])),
-        time_since_step=0.79,
-    )
+    gen = _on_left_foot(config, 0.79)
     com, velocity = gen.initial_com_state()
     dt, announced = 0.001, None
     for k in range(40):
