@@ -303,3 +303,21 @@ def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):
     assert column["push_fx"].sum() * step == pytest.approx(6.0, rel=1e-6)
     assert column["push_fy"].sum() * step == pytest.approx(3.0, rel=1e-6)
     assert np.all(column["left_sole_z"] > -0.005)
+    # The controller's plan next to the ground's: the distributed forces carry the weight;
+    # before the push each foot's measured force follows its planned one, and while the
+    # push moves the planned CoP by centimetres, the net CoP follows it.
+    planned = column["left_fz_planned"] + column["right_fz_planned"]
+    assert planned[quiet].mean() == pytest.approx(mass * GRAVITY, rel=1e-3)
+    for foot in ("left", "right"):
+        gap = np.abs(column[f"{foot}_fz"] - column[f"{foot}_fz_planned"])[quiet]
+        assert gap.mean() < 0.03 * mass * GRAVITY, foot
+    total = column["left_fz"] + column["right_fz"]
+    net_cop = [
+        sum(column[f"{f}_fz"] * np.nan_to_num(column[f"{f}_cop_{a}"]) for f in ("left", "right"))
+        / total
+        for a in "xy"
+    ]
+    distance = np.hypot(net_cop[0] - column["planned_cop_x"], net_cop[1] - column["planned_cop_y"])
+    pushed = (column["t"] >= 0.3) & (column["t"] < 0.6)
+    assert np.abs(column["planned_cop_x"][pushed]).max() > 0.03  # [m]
+    assert distance[pushed].mean() < 0.005  # [m]

@@ -5,7 +5,9 @@ takes the weight within a few milliseconds, an impact of several kN can throw th
 whole robot off the ground for tens of milliseconds, and the feet can rock in turn.
 ``rsg run --physics-log`` records, after every physics step, the whole-body CoM
 position and velocity, each foot's normal force and CoP, and each sole's position,
-to ``physics.csv`` (SI units), so such events can be seen and measured.
+to ``physics.csv`` (SI units), so such events can be seen and measured; next to them,
+what the controller asked for over that tick: the CoP and each foot's normal force of
+the wrench distribution (so a gap between plan and ground shows where it arises).
 
 The log only observes: the run with it ends in exactly the state of the run without
 it (a test checks this). PyBullet refreshes its collision transforms when asked for
@@ -17,6 +19,7 @@ one physics step behind the CoM columns (3 mm for a sole moving at 1.5 m/s at G1
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +27,7 @@ from numpy.typing import NDArray
 
 from app.backends.pybullet_robot import SimulatedRobot
 from planner.exceptions import RsgError
+from planner.types import Foot
 
 COLUMNS = (
     "t",
@@ -33,15 +37,26 @@ COLUMNS = (
     *(f"{foot}_sole_{a}" for foot in ("left", "right") for a in "xyz"),
     "push_fx",
     "push_fy",
+    "planned_cop_x",
+    "planned_cop_y",
+    "left_fz_planned",
+    "right_fz_planned",
 )
 
 
 class PhysicsLog:
     """Rows of :data:`COLUMNS`, one per physics step (a foot without contact has
-    zero force and its CoP as NaN)."""
+    zero force and its CoP as NaN; a foot given no wrench has a planned force of 0)."""
 
     def __init__(self) -> None:
         self.rows: list[list[float]] = []
+        self._plan = [float("nan")] * 2 + [0.0, 0.0]
+
+    def plan(self, cop: NDArray[np.float64], normal_forces: Mapping[Foot, float]) -> None:
+        """The controller's CoP [m] and feet's normal forces [N] for the coming tick."""
+        self._plan = [float(cop[0]), float(cop[1])] + [
+            float(normal_forces.get(foot, 0.0)) for foot in ("left", "right")
+        ]
 
     def record(self, sim: SimulatedRobot, push_force: NDArray[np.float64] | None) -> None:
         """Append the state after the physics step that ``sim`` has just taken."""
@@ -55,6 +70,7 @@ class PhysicsLog:
             row += list(sim.sole_position(foot, forward_kinematics=False))
         push = np.zeros(2) if push_force is None else np.asarray(push_force, float)[:2]
         row += list(push)
+        row += self._plan
         self.rows.append([float(value) for value in row])
 
     def write(self, path: Path) -> Path:

@@ -133,8 +133,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--physics-log",
         action="store_true",
-        help="also write physics.csv: CoM, foot forces and CoPs, soles at every "
-        "physics step (--model pybullet; touchdowns and impacts)",
+        help="also write physics.csv: CoM, foot forces and CoPs, soles, and the "
+        "controller's planned CoP and foot forces at every physics step (--model "
+        "pybullet; touchdowns and impacts)",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 

@@ -62,6 +62,8 @@ class WholeBodyController:
         expected_contact_force: J^T f of the contact wrenches planned at the last
             tick [N, N m] (what the feed-forward torques are computed for).
         planned_cop: The CoP the feet were asked for at the last tick [m].
+        planned_forces: Foot -> normal force [N] of the wrench it was given at the last
+            tick (the feet given none are absent).
         failure: Why the controller could not command the joints (the IK or the
             wrench distribution had no solution), once it could not.
     """
@@ -123,6 +125,7 @@ class WholeBodyController:
         self._motion_momentum_rate = np.zeros(2)
         self._stance_yaw = 0.0
         self.planned_cop = np.array(com_xy, dtype=float)
+        self.planned_forces: dict[Foot, float] = {}
         self.failure: str | None = None
         self._contacts: list[FootContact] = []
 
@@ -271,6 +274,7 @@ class WholeBodyController:
             self.failure = f"{error} at t = {command.time:.2f} s"
             wrenches = [np.zeros(6) for _ in contacts]
         self._contacts = contacts
+        self.planned_forces = {f: float(w[2]) for f, w in zip(feet, wrenches, strict=True)}
         return feet, wrenches
 
     def _feedforward(
