@@ -321,3 +321,31 @@ def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):
     pushed = (column["t"] >= 0.3) & (column["t"] < 0.6)
     assert np.abs(column["planned_cop_x"][pushed]).max() > 0.03  # [m]
     assert distance[pushed].mean() < 0.005  # [m]
+
+
+def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):
+    """physics.png: each foot's measured and planned normal force, and the feet's net CoP
+    (their forces' weighted mean) against the planned CoP, at the log's times."""
+    from app.backends.physics_log import COLUMNS
+    from app.results.physics_plot import plot_physics
+
+    rows = np.array(pushed_runs[2][1].rows)
+    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    figure = plot_physics(rows, tmp_path / "physics.png")
+    assert (tmp_path / "physics.png").read_bytes()[:4] == b"\x89PNG"
+    forces, cop_x, cop_y = figure.axes
+    lines = {line.get_label(): line for line in forces.lines}
+    for foot in ("left", "right"):
+        np.testing.assert_array_equal(lines[f"{foot}, measured"].get_xdata(), column["t"])
+        np.testing.assert_array_equal(lines[f"{foot}, measured"].get_ydata(), column[f"{foot}_fz"])
+        planned = lines[f"{foot}, planned"].get_ydata()
+        np.testing.assert_array_equal(planned, column[f"{foot}_fz_planned"])
+    total = column["left_fz"] + column["right_fz"]
+    assert np.all(total > 0.0)  # standing: the net CoP is defined at every step
+    for axes, axis in ((cop_x, "x"), (cop_y, "y")):
+        measured, planned = axes.lines
+        moments = sum(
+            column[f"{f}_fz"] * np.nan_to_num(column[f"{f}_cop_{axis}"]) for f in ("left", "right")
+        )
+        np.testing.assert_allclose(measured.get_ydata(), moments / total)
+        np.testing.assert_array_equal(planned.get_ydata(), column[f"planned_cop_{axis}"])

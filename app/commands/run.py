@@ -70,6 +70,8 @@ outputs in --out (a folder with an earlier run's results is refused without --ov
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
   replay.npz       the run for the browser: rsg replay FOLDER
+  physics.csv      with --physics-log: every physics step, the ground against the plan
+  physics.png      with --physics-log: the feet's forces and CoP against the plan
 
 exit code: 0 recovered, 1 not recovered, 2 bad input, 130 interrupted (Ctrl-C: what was
 simulated is written, summary.json says "interrupted": true)
@@ -135,7 +137,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write physics.csv: CoM, foot forces and CoPs, soles, and the "
         "controller's planned CoP and foot forces at every physics step (--model "
-        "pybullet; touchdowns and impacts)",
+        "pybullet; touchdowns and impacts), and physics.png: the feet's forces and "
+        "CoP against the plan",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
@@ -241,6 +244,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"wrote {out / name}")
     if physics_log is not None:
         print(f"wrote {physics_log.write(out / 'physics.csv')}")
+        if not args.no_plots and physics_log.rows:
+            from app.results.physics_plot import plot_physics
+
+            plot_physics(np.array(physics_log.rows), out / "physics.png", scenario.name)
+            print(f"wrote {out / 'physics.png'}")
     if not args.no_plots and len(result.timeseries) >= 2:
         print(f"wrote {out}/fig6a_top_view.png, fig6b_time_since_step.png, fig6c_dcm_error.png")
     print(f"wrote {recorder.write(result, args.controller, robot, out)} (rsg replay {out})")

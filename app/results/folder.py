@@ -28,6 +28,7 @@ RESULT_FILES: dict[str, tuple[str, ...]] = {
         "summary.json",
         "timeseries.csv",
         "physics.csv",
+        "physics.png",
         "fig6a_top_view.png",
         "fig6b_time_since_step.png",
         "fig6c_dcm_error.png",
