@@ -8,6 +8,7 @@ stabilizer planned (a swing sole pressing before the step, a sole rocking on an 
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
@@ -19,32 +20,29 @@ from numpy.typing import NDArray  # noqa: E402
 
 from app.backends.physics_log import COLUMNS  # noqa: E402
 
+FEET = ("left", "right")
 FOOT_COLOURS = {"left": "tab:blue", "right": "tab:orange"}
 
 
-def net_cop(rows: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Net CoP (x, y) [m] of the feet on the ground per row, shape (n, 2) (NaN in the air)."""
-    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+def net_cop(column: Mapping[str, NDArray[np.float64]]) -> NDArray[np.float64]:
+    """Net CoP (x, y) [m] of the feet on the ground per row, shape (n, 2) (NaN in the air),
+    from the physics log's columns by name."""
     total = column["left_fz"] + column["right_fz"]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.stack(
-            [
-                sum(
-                    column[f"{foot}_fz"] * np.nan_to_num(column[f"{foot}_cop_{axis}"])
-                    for foot in ("left", "right")
-                )
-                / np.where(total > 0.0, total, np.nan)
-                for axis in "xy"
-            ],
-            axis=1,
-        )
+    total = np.where(total > 0.0, total, np.nan)
+    return np.stack(
+        [
+            sum(column[f"{f}_fz"] * np.nan_to_num(column[f"{f}_cop_{axis}"]) for f in FEET) / total
+            for axis in "xy"
+        ],
+        axis=1,
+    )
 
 
 def plot_physics(rows: NDArray[np.float64], path: Path, title: str = "") -> plt.Figure:
     """Write ``physics.png`` at ``path``; returns the figure (closed)."""
     column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
     t = column["t"]
-    cop = net_cop(rows)
+    cop = net_cop(column)
     fig, axes = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
     for foot, colour in FOOT_COLOURS.items():
         axes[0].plot(t, column[f"{foot}_fz"], color=colour, lw=1, label=f"{foot}, measured")
