@@ -4,6 +4,7 @@ determinism and the physics log."""
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -321,6 +322,37 @@ def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):
     pushed = (column["t"] >= 0.3) & (column["t"] < 0.6)
     assert np.abs(column["planned_cop_x"][pushed]).max() > 0.03  # [m]
     assert distance[pushed].mean() < 0.005  # [m]
+
+
+def test_the_physics_log_records_where_the_soles_were_sent(tmp_path):
+    """``rsg run --physics-log`` on G1's walk: the swing sole's target lifts to the swing
+    height and travels a stride; each sole follows its target, within millimetres while
+    it carries load and within centimetres in the air."""
+    from app.backends.physics_log import COLUMNS
+    from app.cli import main
+
+    argv = ["run", "--scenario", "walk", "--duration", "1.0", "--physics-log", "--quiet"]
+    main([*argv, "--out", str(tmp_path)])
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert not summary["fell"]
+    header, *lines = (tmp_path / "physics.csv").read_text().splitlines()
+    assert tuple(header.split(",")) == COLUMNS
+    rows = np.array([[float(v) for v in line.split(",")] for line in lines])
+    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    loaded_force = 0.05 * summary["mass"] * GRAVITY  # [N] the controller's contact threshold
+    for foot in ("left", "right"):
+        target = np.stack([column[f"{foot}_sole_target_{a}"] for a in "xyz"], axis=1)
+        sole = np.stack([column[f"{foot}_sole_{a}"] for a in "xyz"], axis=1)
+        assert np.isfinite(target).all(), foot
+        gap = np.linalg.norm(sole[:, :2] - target[:, :2], axis=1)
+        loaded = column[f"{foot}_fz"] > loaded_force
+        assert loaded.any() and (~loaded).any(), foot  # each foot stands and swings
+        assert gap[loaded].mean() < 0.005 and gap[loaded].max() < 0.02, foot  # [m]
+        assert gap[~loaded].mean() < 0.02, foot  # [m]
+    swing = max(("left", "right"), key=lambda foot: column[f"{foot}_sole_target_z"].max())
+    assert np.ptp(column[f"{swing}_sole_target_x"]) > 0.15  # a stride, [m]
+    apex = get_robot("g1").swing_height  # [m] the swing profile's top, exactly
+    assert column[f"{swing}_sole_target_z"].max() == pytest.approx(apex, abs=1e-6)
 
 
 def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):

@@ -7,7 +7,9 @@ whole robot off the ground for tens of milliseconds, and the feet can rock in tu
 position and velocity, each foot's normal force and CoP, and each sole's position,
 to ``physics.csv`` (SI units), so such events can be seen and measured; next to them,
 what the controller asked for over that tick: the CoP and each foot's normal force of
-the wrench distribution (so a gap between plan and ground shows where it arises).
+the wrench distribution, and where it asked the IK to put each sole (so a gap between
+plan and ground shows where it arises: a sole that lands off its target, a load the
+plan did not give).
 
 The log only observes: the run with it ends in exactly the state of the run without
 it (a test checks this). PyBullet refreshes its collision transforms when asked for
@@ -41,6 +43,7 @@ COLUMNS = (
     "planned_cop_y",
     "left_fz_planned",
     "right_fz_planned",
+    *(f"{foot}_sole_target_{a}" for foot in ("left", "right") for a in "xyz"),
 )
 
 
@@ -50,13 +53,21 @@ class PhysicsLog:
 
     def __init__(self) -> None:
         self.rows: list[list[float]] = []
-        self._plan = [float("nan")] * 2 + [0.0, 0.0]
+        self._plan = [float("nan")] * 2 + [0.0, 0.0] + [float("nan")] * 6
 
-    def plan(self, cop: NDArray[np.float64], normal_forces: Mapping[Foot, float]) -> None:
-        """The controller's CoP [m] and feet's normal forces [N] for the coming tick."""
+    def plan(
+        self,
+        cop: NDArray[np.float64],
+        normal_forces: Mapping[Foot, float],
+        sole_targets: Mapping[Foot, NDArray[np.float64]],
+    ) -> None:
+        """The controller's CoP [m], feet's normal forces [N] and soles' target
+        positions [m] (world, shape (3,) each) for the coming tick."""
         self._plan = [float(cop[0]), float(cop[1])] + [
             float(normal_forces.get(foot, 0.0)) for foot in ("left", "right")
         ]
+        for foot in ("left", "right"):
+            self._plan += [float(v) for v in sole_targets[foot][:3]]
 
     def record(self, sim: SimulatedRobot, push_force: NDArray[np.float64] | None) -> None:
         """Append the state after the physics step that ``sim`` has just taken."""

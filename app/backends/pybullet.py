@@ -186,7 +186,10 @@ class PyBulletBackend:
         joint_command = self.controller.tick(self._measurement, command)
         controlled = clock.perf_counter()
         if self.physics_log is not None:
-            self.physics_log.plan(self.controller.planned_cop, self.controller.planned_forces)
+            controller = self.controller
+            self.physics_log.plan(
+                controller.planned_cop, controller.planned_forces, controller.sole_targets
+            )
         force = np.array([push_force[0], push_force[1], 0.0]) if any(push_force) else None
         self.sim.actuate(
             joint_command,

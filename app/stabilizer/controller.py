@@ -64,6 +64,8 @@ class WholeBodyController:
         planned_cop: The CoP the feet were asked for at the last tick [m].
         planned_forces: Foot -> normal force [N] of the wrench it was given at the last
             tick (the feet given none are absent).
+        sole_targets: Foot -> where the IK was asked to put its sole at the last tick
+            [m], world, shape (3,).
         failure: Why the controller could not command the joints (the IK or the
             wrench distribution had no solution), once it could not.
     """
@@ -126,6 +128,9 @@ class WholeBodyController:
         self._stance_yaw = 0.0
         self.planned_cop = np.array(com_xy, dtype=float)
         self.planned_forces: dict[Foot, float] = {}
+        self.sole_targets: dict[Foot, NDArray[np.float64]] = {
+            foot: np.full(3, np.nan) for foot in ("left", "right")
+        }
         self.failure: str | None = None
         self._contacts: list[FootContact] = []
 
@@ -176,6 +181,7 @@ class WholeBodyController:
         )
         # swing foot
         soles = self._sole_targets(command, stance, swing)
+        self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
         # IK
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
