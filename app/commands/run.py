@@ -136,9 +136,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--physics-log",
         action="store_true",
         help="also write physics.csv: CoM, foot forces and CoPs, soles, and the "
-        "controller's planned CoP and foot forces at every physics step (--model "
-        "pybullet; touchdowns and impacts), and physics.png: the feet's forces and "
-        "CoP against the plan",
+        "controller's planned CoP, foot forces and sole targets at every physics step "
+        "(--model pybullet; touchdowns and impacts), and physics.png: the feet's forces "
+        "and CoP against the plan",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
