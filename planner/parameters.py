@@ -232,7 +232,8 @@ class Constraints:
         return np.array([*self.zmp_window_max, h, h])
 
 
-_RSG_FLAGS = ("qp_at_timing_jump", "announced_foothold")  # True/False options of RsgParameters
+# True/False options of RsgParameters
+_RSG_FLAGS = ("qp_at_timing_jump", "announced_foothold", "preview_at_touchdown")
 
 
 @dataclass(frozen=True)
@@ -273,6 +274,10 @@ class RsgParameters:
             steps onto the foothold announced at the tick before, where a real swing
             foot was sent and has touched down by then; False (the paper): H_nu at the
             jump's own state.
+        preview_at_touchdown: An extension of the announced next step: while V_u >=
+            gamma_v it is the QP (27) at the state predicted when the step is expected
+            (the LIPM under the current input), so a swing foot is sent from its
+            lift-off where a pushed step will land; False: the QP at the current state.
     """
 
     filter_time_constant: float = 0.05
@@ -291,6 +296,7 @@ class RsgParameters:
     dcm_inset: float | None = None
     qp_at_timing_jump: bool = True
     announced_foothold: bool = True
+    preview_at_touchdown: bool = True
 
     def __post_init__(self) -> None:
         for flag in _RSG_FLAGS:

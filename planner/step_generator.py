@@ -287,8 +287,10 @@ class ReactiveStepGenerator:
 
         With a jump held for the touchdown it is that jump's foothold; with a timing
         jump scheduled it is the QP (27) at the state predicted at its touchdown; with
-        V_u >= gamma_v the QP at the current state; otherwise the nominal step 2 xi1*
-        at the reference's next (gated) nominal jump.
+        V_u >= gamma_v the QP at the state predicted when the step is expected
+        (:meth:`predicted_step_time`; at the current state without
+        ``preview_at_touchdown``); otherwise the nominal step 2 xi1* at the reference's
+        next (gated) nominal jump.
 
         Args:
             xi: (c_H - o_H, cdot_H) now.
@@ -306,10 +308,15 @@ class ReactiveStepGenerator:
                 predicted, predicted_error, level, "exact", reference_xi1
             )
             return self.stance + step, from_qp
-        if self.config.adjusts_location and level >= self.design.threshold:
-            step, _, _ = self._step_location(xi, error, level, "exact")
-            return self.stance + step, True
         wait = self._nominal_wait() if nominal_wait is None else nominal_wait
+        if self.config.adjusts_location and level >= self.design.threshold:
+            if self.config.rsg.preview_at_touchdown:  # H_nu at the predicted touchdown
+                delay = self._timing_jump_delay(wait) if self.config.adjusts_timing else wait
+                xi, error, reference_xi1 = self.predict(xi, delay)
+                step, _, _ = self._step_location(xi, error, level, "exact", reference_xi1)
+            else:
+                step, _, _ = self._step_location(xi, error, level, "exact")
+            return self.stance + step, True
         future = flow_autonomous(self.omega, self.reference.state, wait)
         return self.stance + 2.0 * future[:2], False
 

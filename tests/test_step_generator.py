@@ -533,3 +533,33 @@ def test_a_measured_stance_sole_is_approached_with_the_reanchor_time_constant():
     assert stepped is not None
     next_out = gen.update(MeasuredState(0.1, com, velocity), 0.01)
     np.testing.assert_array_equal(next_out.stance.position, stepped.stance.position)
+
+
+def _g1_outward_step(preview_at_touchdown: bool):
+    """G1's planner on the LIPM, pushed 8.9 N s towards its stance side early in the
+    single support: a step beside the stance foot (27b), then the stance foot's outward
+    step. Returns the outward step and the next steps previewed from its swing's start."""
+    from app.setup.robot_config import planner_config_for
+    from robots.g1 import G1
+
+    config = planner_config_for(G1, G1.total_mass)
+    config = replace(config, rsg=replace(config.rsg, preview_at_touchdown=preview_at_touchdown))
+    force = np.array([-1.4155, 8.8374]) / 0.057  # [N] over 57 ms
+    outputs, _ = _walk_with_push(config, 3.1408, force, 0.057, 4.2)
+    steps = [k for k, o in enumerate(outputs) if o.step is not None and o.time > 3.1408]
+    first, second = steps[0], steps[1]
+    lift_off = first + round(config.gait.double_support_duration / 0.001)
+    return outputs[second].step, [o.next_step.position for o in outputs[lift_off:second]]
+
+
+def test_the_swing_foot_is_sent_where_a_pushed_step_lands():
+    """preview_at_touchdown: while V_u >= gamma_v the next step is the QP (27) at the
+    state predicted when the step is expected, so the foot that must step outwards after
+    a crossing step is sent there from its lift-off; at the current state (False) the
+    foothold is 0.3 m short until the timing jump is decided."""
+    step, previews = _g1_outward_step(True)
+    assert step.location_adjusted and step.position[1] > 0.5  # [m] outward, to the left
+    errors = np.linalg.norm(np.array(previews) - step.position, axis=1)
+    assert errors.max() < 0.01, errors.max()
+    step, previews = _g1_outward_step(False)
+    assert np.linalg.norm(previews[0] - step.position) > 0.2
