@@ -301,22 +301,20 @@ class ReactiveStepGenerator:
             return self.held_step.foothold.copy(), self.held_step.from_qp
         error = self.dcm_error(xi) if error is None else error
         level = self.design.level(error)
-        if self.scheduled_step is not None and self.config.adjusts_location:
-            delay = self.scheduled_step - self.time_since_step
+        wait = self._nominal_wait() if nominal_wait is None else nominal_wait
+        scheduled = self.scheduled_step is not None
+        if self.config.adjusts_location and (scheduled or level >= self.design.threshold):
+            # H_nu at the state predicted at the touchdown (now without preview_at_touchdown)
+            delay = 0.0
+            if self.scheduled_step is not None:
+                delay = self.scheduled_step - self.time_since_step
+            elif self.config.rsg.preview_at_touchdown:
+                delay = self._timing_jump_delay(wait) if self.config.adjusts_timing else wait
             predicted, predicted_error, reference_xi1 = self.predict(xi, delay)
             step, from_qp, _ = self._step_location(
                 predicted, predicted_error, level, "exact", reference_xi1
             )
             return self.stance + step, from_qp
-        wait = self._nominal_wait() if nominal_wait is None else nominal_wait
-        if self.config.adjusts_location and level >= self.design.threshold:
-            if self.config.rsg.preview_at_touchdown:  # H_nu at the predicted touchdown
-                delay = self._timing_jump_delay(wait) if self.config.adjusts_timing else wait
-                xi, error, reference_xi1 = self.predict(xi, delay)
-                step, _, _ = self._step_location(xi, error, level, "exact", reference_xi1)
-            else:
-                step, _, _ = self._step_location(xi, error, level, "exact")
-            return self.stance + step, True
         future = flow_autonomous(self.omega, self.reference.state, wait)
         return self.stance + 2.0 * future[:2], False
 
