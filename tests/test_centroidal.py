@@ -6,7 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from app.stabilizer.centroidal import centre_of_pressure, contact_force, pivot, sway_rate
+from app.stabilizer.centroidal import (
+    centre_of_pressure,
+    contact_force,
+    momentum_velocity,
+    pivot,
+    sway_rate,
+)
+from planner.hybrid_lipm import H_MATRIX
 from planner.parameters import GRAVITY, LipmModel
 from robots import get_robot
 
@@ -116,3 +123,48 @@ def test_in_single_support_the_cop_is_clipped_to_the_stance_sole():
         double = centre_of_pressure(wanted, np.zeros(2), MODEL.mass, stance, SOLE, True)
         np.testing.assert_array_equal(double, wanted)
     assert clipped > 100
+
+
+def point_masses(rng, count=12):
+    """Random point masses [kg], positions [m] (CoM at MODEL.com_height) and velocities
+    [m/s] (no vertical CoM velocity): a robot whose limbs move any way."""
+    masses = rng.uniform(0.5, 5.0, count)
+    positions = rng.uniform(-0.4, 0.4, (count, 3))
+    velocities = rng.uniform(-1.0, 1.0, (count, 3))
+    positions += np.array([0.0, 0.0, MODEL.com_height]) - masses @ positions / masses.sum()
+    velocities[:, 2] -= masses @ velocities[:, 2] / masses.sum()
+    return masses, positions, velocities
+
+
+def test_the_momentum_velocity_is_the_angular_momentum_about_any_ground_point():
+    """m Z H u = L_p, the horizontal angular momentum about any point p of the ground,
+    whatever h_r: gravity is the only external force with a moment about the CoP, so u
+    changes at omega^2 (c - cop) whatever the limbs do."""
+    rng = np.random.default_rng(RNG_SEED)
+    for _ in range(20):
+        masses, positions, velocities = point_masses(rng)
+        mass = masses.sum()
+        com = masses @ positions / mass
+        com_velocity = masses @ velocities / mass
+
+        def momentum_about(point, masses=masses, positions=positions, velocities=velocities):
+            arms = positions - point
+            return np.sum(np.cross(arms, masses[:, None] * velocities), axis=0)[:2]
+
+        h_r = rng.uniform(0.0, 0.2)
+        pendulum = MODEL.com_height + h_r
+        u = momentum_velocity(com_velocity[:2], momentum_about(com), mass, pendulum, h_r)
+        ground = np.array([*rng.uniform(-1.0, 1.0, 2), 0.0])
+        np.testing.assert_allclose(
+            mass * pendulum * H_MATRIX @ u, momentum_about(ground), atol=1e-9
+        )
+
+
+def test_a_body_that_only_sways_has_its_com_velocity_as_momentum_velocity():
+    """L = m h_r H cdot, the share the pendulum's height holds: u = cdot."""
+    rng = np.random.default_rng(RNG_SEED)
+    h_r = 0.1
+    for com_velocity in rng.uniform(-1.0, 1.0, (10, 2)):
+        sway = MODEL.mass * h_r * H_MATRIX @ com_velocity
+        u = momentum_velocity(com_velocity, sway, MODEL.mass, MODEL.com_height + h_r, h_r)
+        np.testing.assert_allclose(u, com_velocity, atol=1e-12)

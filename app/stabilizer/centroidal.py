@@ -25,6 +25,19 @@ the CoP, the CoM moves as a pendulum c_z + h_r tall about the CoP; the planner's
 that tall (``RobotDescription.pendulum_height``), so the sway's share is left out of the
 CoP (:func:`sway_rate`): a CoP on the sole's edge then stops the CoM as the planner
 expects, where a LIPM at c_z would expect more than the robot can do.
+
+What the CoP cannot do (clipped at a sole's edge) the limbs' momentum does to the CoM,
+and the planner sees it as a DCM error. The angular momentum about the CoP changes only
+by gravity's moment (the ground's force passes through the CoP), so for a CoM at
+constant height the velocity
+
+    u = cdot + H^T (L - m h_r H cdot) / (m Z),      d/dt u = omega^2 (c - cop),
+
+moves as the LIPM's whatever the limbs do (L the centroidal angular momentum, Z the
+planner's pendulum height): it is the CoM velocity once the limbs' momentum is back in
+the CoM. :func:`momentum_velocity`; the planner reads it with the option
+``momentum_velocity`` (Orin, Goswami and Lee, "Centroidal dynamics of a humanoid robot",
+Auton. Robots 2013, for L).
 """
 
 from __future__ import annotations
@@ -75,3 +88,25 @@ def sway_rate(force: NDArray[np.float64], rotational_height: float) -> NDArray[n
     """Angular momentum rate of the body's sway, m h_r H cdd = h_r H f [N m], shape (2,),
     for the net ground ``force`` [N] and h_r ``rotational_height`` [m]."""
     return rotational_height * (H_MATRIX @ np.asarray(force, float)[:2])
+
+
+def momentum_velocity(
+    com_velocity: NDArray[np.float64],
+    angular_momentum: NDArray[np.float64],
+    mass: float,
+    pendulum_height: float,
+    rotational_height: float,
+) -> NDArray[np.float64]:
+    """u = cdot + H^T (L - m h_r H cdot) / (m Z) [m/s], shape (2,): m Z H u is the
+    horizontal angular momentum about any point of the ground (module docstring).
+
+    Args:
+        com_velocity: Horizontal CoM velocity cdot [m/s], (2,).
+        angular_momentum: Horizontal centroidal angular momentum L [N m s], (2,).
+        mass: m [kg].
+        pendulum_height: Z, the planner's pendulum height [m].
+        rotational_height: h_r [m], the sway's share of L per unit m H cdot.
+    """
+    velocity = np.asarray(com_velocity, float)
+    stored = np.asarray(angular_momentum, float) - mass * rotational_height * (H_MATRIX @ velocity)
+    return velocity + H_MATRIX.T @ stored / (mass * pendulum_height)

@@ -27,6 +27,11 @@ class StabilizerConfig:
         flywheel_cancel: Share of the legs' high-passed angular momentum the upper
             body takes back [-] (a leg swinging outwards otherwise pulls the pivot
             off the stance sole's edge).
+        momentum_velocity: The planner reads the velocity of the angular momentum about
+            the CoP, u (:func:`app.stabilizer.centroidal.momentum_velocity`), instead of
+            the CoM velocity: what a swinging leg holds counts as the CoM velocity it
+            gives back. On for Talos (robots/talos.py); with G1's upper-body flywheel
+            its lateral feedback ran away (docs/notes/2026-12-05-momentum-about-the-cop.md).
     """
 
     estimator: str = "truth"
@@ -35,10 +40,13 @@ class StabilizerConfig:
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.75
+    momentum_velocity: bool = False
 
     def __post_init__(self) -> None:
         if self.estimator not in SOURCES:
             raise ParameterError("estimator", self.estimator, " or ".join(SOURCES))
+        if not isinstance(self.momentum_velocity, bool):
+            raise ParameterError("momentum_velocity", self.momentum_velocity, "true or false")
         for name, (low, high) in RANGES.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):

@@ -303,7 +303,8 @@ class WholeBodyController:
         self, measurement: RobotMeasurement, stance: Foot, double_support: bool
     ) -> MeasuredState:
         """Estimate the state from ``measurement``; return what the planner reads: the
-        CoM, its velocity and, in single support, the stance sole (the planner
+        CoM, its velocity (with ``momentum_velocity``, that of the angular momentum
+        about the CoP) and, in single support, the stance sole (the planner
         re-anchors its foothold there) and whether the swing sole touches the ground
         (a step due before the touchdown waits for it)."""
         self.state = state = self.estimator.update(measurement, stance)
@@ -313,9 +314,16 @@ class WholeBodyController:
             if measurement.normal_force(stance) > threshold:
                 sole = self.model.sole_frame(stance)[0][:2].copy()
             swing_contact = measurement.normal_force(other_foot(stance)) > threshold
-        return MeasuredState(
-            state.time, state.com[:2].copy(), state.com_velocity[:2].copy(), swing_contact, sole
-        )
+        velocity = state.com_velocity[:2].copy()
+        if self.config.momentum_velocity:
+            velocity = centroidal.momentum_velocity(
+                velocity,
+                self.model.centroidal_angular_momentum()[:2],
+                self.mass,
+                self.lipm.com_height,
+                self.description.rotational_height,
+            )
+        return MeasuredState(state.time, state.com[:2].copy(), velocity, swing_contact, sole)
 
 
 def joint_impedance(
