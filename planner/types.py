@@ -76,9 +76,9 @@ class MeasuredState:
         time: Time [s].
         com_position: Horizontal CoM c_H in the world [m], shape (2,).
         com_velocity: Horizontal CoM velocity [m/s], shape (2,). A robot whose limbs
-            carry angular momentum reports the velocity of its momentum about the CoP
-            (the CoM's once the limbs' momentum is back in the CoM), which moves as the
-            LIPM's.
+            carry angular momentum may report the velocity of its momentum about the CoP
+            instead (the CoM's once the limbs' momentum is back in the CoM), which moves
+            as the LIPM's.
         swing_contact: Whether the swing sole touches the ground, when the backend
             measures it (foot force sensors); a jump that is due while it is False waits
             for the touchdown. None: the planner steps at its own jump time.

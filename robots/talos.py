@@ -22,7 +22,7 @@ whole-body stabilizer's defaults, chosen on G1, are used (its joint gains follow
 each joint's effort limit) but one: the planner reads the velocity of the angular
 momentum about the CoP (``momentum_velocity``): what its heavy swinging leg holds is
 counted as the CoM velocity it gives back (development pushes, seeds 1 and 3: 92 and 96
-of 100 recovered against 91 and 88, and 12 % fewer adjusted steps;
+of 100 recovered against 91 and 88, and 9 % fewer adjusted steps, 288 against 317;
 docs/notes/2026-12-05-momentum-about-the-cop.md). Talos lists no upper-body joints, so it has no
 flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders
 did no better on the development pushes, and worse taking back the legs' momentum;

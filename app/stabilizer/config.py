@@ -30,8 +30,9 @@ class StabilizerConfig:
         momentum_velocity: The planner reads the velocity of the angular momentum about
             the CoP, u (:func:`app.stabilizer.centroidal.momentum_velocity`), instead of
             the CoM velocity: what a swinging leg holds counts as the CoM velocity it
-            gives back. On for Talos (robots/talos.py); with G1's upper-body flywheel
-            its lateral feedback ran away (docs/notes/2026-12-05-momentum-about-the-cop.md).
+            gives back. On for Talos (robots/talos.py); off for G1, whose upper-body
+            flywheel's momentum it counts with the limbs' (92 of 100 development pushes
+            recovered against 98; docs/notes/2026-12-05-momentum-about-the-cop.md).
     """
 
     estimator: str = "truth"
