@@ -3,8 +3,9 @@
 A step the planner may take outwards (``step_max`` y) is of use only if the robot can
 then stand on both feet: in the double support that follows, both soles are flat on the
 ground and the CoM is between them at its nominal height. The widest such stance is
-set by the joints' ranges (on G1 the ankle roll's +-15 deg, on Talos the hip and ankle
-rolls' +-30 deg), and is found here with the whole-body IK itself: the soles are moved
+set by the joints' ranges (on G1 the ankle roll's +-15 deg; on Talos the knees, straight
+but for the IK's margin, with the hip and ankle rolls near their +-30 deg), and is found
+here with the whole-body IK itself: the soles are moved
 apart symmetrically from the nominal stance, the CoM kept midway, until the IK can no
 longer hold them.
 """

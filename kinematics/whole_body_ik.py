@@ -8,6 +8,12 @@ of the simulation and moves it, once per control tick, so that:
 * the CoM follows the target [m] (soft, high weight);
 * the trunk and the pelvis stay upright with the feet's mean yaw (soft);
 * the joints stay near the standing posture (soft, low weight), within limits;
+* the knees stay bent by at least ``KNEE_MARGIN``: a straight knee is a singularity of
+  the legs' Jacobian, where the QP's step flips between ticks (after a wide step on
+  G1, a knee target jumped by up to 2.3 rad from one 10 ms tick to the next);
+* the joints the plan does not move (neither a leg's, nor the flywheel's, nor locked:
+  Talos's torso, arms and head) hold their standing angles (soft, the trunk's
+  weight), so the IK does not swing the arms to move the CoM;
 * the description's ``locked_joints`` stay at their standing angle (masked: the
   physics URDF has them welded, :mod:`robots.urdf_merge`);
 * optionally (``upper_body=True``), the description's ``upper_body_joints`` follow
@@ -69,6 +75,7 @@ FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]
 COM_WEIGHT = 100.0  # CoM task weight [-]
 TRUNK_WEIGHT = 10.0  # trunk and pelvis orientation weight [-]
 POSTURE_WEIGHT = 1e-2  # joint posture regularisation weight [-]
+KNEE_MARGIN = 0.3  # [rad] least knee bend (0.2 rad still let a knee target flip)
 
 
 def kinematic_urdf_text(description: RobotDescription) -> str:
@@ -90,6 +97,19 @@ def humanoid_robot(description: RobotDescription) -> Any:
     text = kinematic_urdf_text(description)
     with native_output_silenced():
         return placo.HumanoidRobot("", placo.Flags.ignore_collisions, text)
+
+
+def leg_joints(model: Any) -> dict[str, list[str]]:
+    """The legs' joints of a pinocchio ``model``: ``"chains"``, every joint from the
+    floating base to either sole's link, and ``"knees"``, the joint above each ankle's two
+    (the two joints nearest the sole, as in :class:`kinematics.robot_model.RobotModel`)."""
+    chains: list[str] = []
+    knees: list[str] = []
+    for frame in FOOT_FRAMES.values():
+        joint = model.frames[model.getFrameId(frame)].parentJoint
+        chains += [model.names[k] for k in model.supports[joint] if k > 1]
+        knees.append(model.names[model.parents[model.parents[joint]]])
+    return {"chains": chains, "knees": knees}
 
 
 def yaw_rotation(yaw: float) -> NDArray[np.float64]:
@@ -144,6 +164,10 @@ class WholeBodyIK:
             self.solver.mask_dof(name)
         self.solver.enable_joint_limits(True)
         self.solver.enable_velocity_limits(False)
+        legs = leg_joints(self.robot.model)
+        for knee in legs["knees"]:
+            lower, upper = self.robot.get_joint_limits(knee)
+            self.robot.set_joint_limits(knee, max(float(lower), KNEE_MARGIN), float(upper))
 
         self.foot_tasks = {
             foot: self.solver.add_frame_task(frame, np.eye(4))
@@ -167,6 +191,13 @@ class WholeBodyIK:
         self.pelvis_task = self.solver.add_orientation_task(description.base_link, np.eye(3))
         self.pelvis_task.configure("pelvis", "soft", TRUNK_WEIGHT)
         standing = self.standing_posture()
+        moved = set(legs["chains"]) | set(self.upper_body_joints) | set(description.locked_joints)
+        self.held_joints = [name for name in self.joint_names if name not in moved]
+        self.held_task = None
+        if self.held_joints:
+            self.held_task = self.solver.add_joints_task()
+            self.held_task.set_joints({name: standing[name] for name in self.held_joints})
+            self.held_task.configure("held", "soft", TRUNK_WEIGHT)
         self.posture_task = self.solver.add_joints_task()
         self.posture_task.set_joints(standing)
         self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)

@@ -11,13 +11,15 @@ above the soles, 0.870 m standing on them in PyBullet, so c_z = 0.87 m. Hips are
 
 Walking: the paper's gait (L_x 0.1 m, L_y 0.2 m, T_DSP 0.1 s, T_SSP 0.7 s), T_SP 0.5 s,
 theta 0.01 s and a step reaction time of 0.2 s as on G1; 1 ms physics. Step bounds: y in
-[-0.87, 0.87] m, as on G1 the legs' lateral reach (the widest stance with flat soles and
-the CoM midway at c_z, ``kinematics/reach.py``; development pushes with y +-0.53, 0.66,
-0.79, 0.87 m: 87, 88, 90, 90 recovered); x in [-0.33, 0.46] m, G1's in units of the CoM
+[-0.83, 0.83] m, as on G1 the legs' lateral reach (the widest stance with flat soles, the
+CoM midway at c_z and the knees bent by the IK's margin, ``kinematics/reach.py``; 0.875 m
+with straight knees; development pushes with y +-0.53, 0.66, 0.79, 0.87 m: 87, 88, 90, 90
+recovered, docs/notes/2026-12-04-lateral-reach.md); x in [-0.33, 0.46] m, G1's in units of the CoM
 height (the LIPM's length scale, 0.87/0.66 = 1.32; docs/notes/2026-12-03-talos-reach.md,
 docs/notes/2026-12-04-lateral-reach.md). The planner's LIPM is c_z + h_r = 0.985 m tall:
 as the IK sways the CoM over the feet the body's angular momentum follows the CoM
-velocity with h_r 0.120 m along x, 0.115 m along y (``kinematics/pendulum.py``). The
+velocity with h_r 0.121 m along x, 0.119 m along y (``kinematics/pendulum.py``; the 0.115 m
+used was measured along y while the IK still moved the arms, within 1 cm of both). The
 whole-body stabilizer's defaults, chosen on G1, are used (its joint gains follow from
 each joint's effort limit) but one: the planner reads the velocity of the angular
 momentum about the CoP (``momentum_velocity``): what its heavy swinging leg holds is
@@ -94,8 +96,8 @@ TALOS = RobotDescription(
     fall_base_height=0.6,
     swing_height=0.06,
     sole_box_collision=True,
-    step_min=(-0.33, -0.87),  # x: G1's x 0.87 / 0.66; y: the legs' reach
-    step_max=(0.46, 0.87),
+    step_min=(-0.33, -0.83),  # x: G1's x 0.87 / 0.66; y: the legs' reach
+    step_max=(0.46, 0.83),
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,

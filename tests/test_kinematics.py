@@ -8,7 +8,7 @@ import pytest
 from kinematics.pendulum import rotational_height
 from kinematics.reach import holds, lateral_reach, stance
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
-from kinematics.whole_body_ik import WholeBodyIK, sole_pose
+from kinematics.whole_body_ik import KNEE_MARGIN, WholeBodyIK, leg_joints, sole_pose
 from planner.exceptions import ParameterError
 from robots import get_robot
 
@@ -223,3 +223,53 @@ def test_each_robots_pendulum_is_as_tall_as_its_whole_body_motion_makes_it(robot
     for measured in (along_x, along_y):
         assert abs(description.rotational_height - measured) <= 0.01, (robot, measured)
     assert description.pendulum_height == description.com_height + description.rotational_height
+
+
+def _sway_in_a_wide_stance(ik, description, width):
+    """Joint angles [rad] of each 10 ms solve while the soles spread from the nominal
+    stance to ``width`` [m] in 0.5 s and the CoM then sways 0.6 of the way to a sole
+    and back in 1 s (a double support after a wide outward step)."""
+    ik.reset(*stance(description.foot_spacing), np.zeros(2))
+    solutions = [ik.joint_angles()]
+    for i in range(150):
+        spread = description.foot_spacing + (width - description.foot_spacing) * min(i / 50, 1.0)
+        sway = 0.0 if i < 50 else 0.3 * spread * np.sin(np.pi * (i - 50) / 100)
+        solutions.append(ik.solve(np.array([0.0, sway]), *stance(spread), "both", DT))
+    return np.array(solutions)
+
+
+@pytest.mark.parametrize(("robot", "width"), [("g1", 0.55), ("talos", 0.8)])
+def test_the_ik_keeps_its_knees_off_the_singularity_in_a_wide_stance(robot, width):
+    """In a stance as wide as the outward step bound the legs are nearly straight; with
+    the CoM swaying over it, the knees stay bent by KNEE_MARGIN and no joint target moves
+    more than 0.15 rad from one 10 ms tick to the next (at a straight knee the QP's step
+    flips: up to 1.9 rad per tick on G1 without the margin)."""
+    description = get_robot(robot)
+    ik = WholeBodyIK(description, upper_body=bool(description.upper_body_joints))
+    solutions = _sway_in_a_wide_stance(ik, description, width)
+    knees = [ik.joint_names.index(name) for name in leg_joints(ik.robot.model)["knees"]]
+    assert solutions[:, knees].min() >= KNEE_MARGIN - 1e-6
+    assert np.abs(np.diff(solutions, axis=0)).max() <= 0.15
+
+
+def test_the_ik_holds_the_joints_the_plan_does_not_move():
+    """Talos has no flywheel: its torso, arms and head hold their standing angles (within
+    0.1 rad) while the IK sways the CoM over a 0.8 m wide stance, where the legs are near
+    their limits (without the hold the arms swing 2.7 rad, up to 4.9 rad in a tick)."""
+    description = get_robot("talos")
+    ik = WholeBodyIK(description)
+    assert {"arm_left_1_joint", "torso_1_joint", "head_1_joint"} <= set(ik.held_joints)
+    assert not set(ik.held_joints) & set(leg_joints(ik.robot.model)["chains"])
+    solutions = _sway_in_a_wide_stance(ik, description, 0.8)
+    standing = ik.standing_posture()
+    held = [ik.joint_names.index(name) for name in ik.held_joints]
+    posture = np.array([standing[name] for name in ik.held_joints])
+    assert np.abs(solutions[:, held] - posture).max() <= 0.1
+
+
+def test_g1s_flywheel_joints_are_not_held():
+    """G1's upper body is its flywheel: with the flywheel every joint the IK may move is
+    a leg's or the flywheel's (none is held); without it, the flywheel's joints hold."""
+    description = get_robot("g1")
+    assert WholeBodyIK(description, upper_body=True).held_joints == []
+    assert set(WholeBodyIK(description).held_joints) == set(description.upper_body_joints)
