@@ -134,6 +134,8 @@ class WholeBodyIK:
         robot: The placo model (its state is the last IK solution).
         angular_momentum: Centroidal angular momentum [N m s], shape (3,), of the
             motion of the last :meth:`solve` (finite difference over its ``dt``).
+        held_joints: Joints held at their standing angles: neither a leg's, nor the
+            flywheel's, nor locked.
     """
 
     def __init__(
