@@ -195,11 +195,10 @@ class WholeBodyIK:
         standing = self.standing_posture()
         moved = set(legs["chains"]) | set(self.upper_body_joints) | set(description.locked_joints)
         self.held_joints = [name for name in self.joint_names if name not in moved]
-        self.held_task = None
-        if self.held_joints:
-            self.held_task = self.solver.add_joints_task()
-            self.held_task.set_joints({name: standing[name] for name in self.held_joints})
-            self.held_task.configure("held", "soft", TRUNK_WEIGHT)
+        if self.held_joints:  # the solver owns the task; its targets never change
+            held_task = self.solver.add_joints_task()
+            held_task.set_joints({name: standing[name] for name in self.held_joints})
+            held_task.configure("held", "soft", TRUNK_WEIGHT)
         self.posture_task = self.solver.add_joints_task()
         self.posture_task.set_joints(standing)
         self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
