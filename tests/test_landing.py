@@ -27,22 +27,38 @@ def landing() -> Landing:
 def test_the_swing_target_sinks_to_the_depth_by_the_landing_time_and_not_before():
     rule = landing()
     profile = 0.02
-    before = [rule.swing_height(profile, t) for t in (1.0, 0.5, WINDOW + 1e-9)]
+    landing_time = 0.3  # [s] after the swing began
+    before = [rule.swing_height(profile, t, landing_time - t) for t in (0.3, 0.2, WINDOW + 1e-9)]
     assert before == [profile] * 3
     times = np.linspace(WINDOW, 0.0, 11)
-    heights = np.array([rule.swing_height(profile, t) for t in times])
+    heights = np.array([rule.swing_height(profile, t, landing_time - t) for t in times])
     assert heights[0] == pytest.approx(profile)
     assert heights[-1] == pytest.approx(profile - DEPTH)
     assert np.all(np.diff(heights) < 0.0)  # going down all the way
     # A touchdown that comes late: the target goes on down at the touchdown speed.
-    late = [rule.swing_height(profile, -t) for t in (0.05, 0.1)]
+    late = [rule.swing_height(profile, -t, landing_time + t) for t in (0.05, 0.1)]
     expected = [profile - DEPTH - t * TOUCHDOWN_SPEED for t in (0.05, 0.1)]
     assert late == pytest.approx(expected)
 
 
+def test_a_late_touchdown_sinks_while_the_planner_waits_for_it():
+    """While the planner waits for the touchdown it announces the step one tick ahead at
+    every tick: the time left stays at minus one tick, and the target still goes on down
+    at the touchdown speed from the planned landing time, until a new swing begins."""
+    rule = landing()
+    profile, tick, landing_time = 0.0, 0.01, 0.3
+    rule.swing_height(profile, 0.0, landing_time)
+    waiting = np.arange(1, 11) * tick
+    heights = [rule.swing_height(profile, -tick, landing_time + t) for t in waiting]
+    expected = profile - DEPTH - waiting * TOUCHDOWN_SPEED
+    np.testing.assert_allclose(heights, expected)
+    rule.start_swing()
+    assert rule.swing_height(profile, 0.2, 0.1) == profile  # the next swing starts afresh
+
+
 def test_the_new_stance_sole_settles_from_the_last_swing_height_to_the_ground():
     rule = landing()
-    last = rule.swing_height(0.004, 0.05)  # the swing's last target, 1.5 mm up
+    last = rule.swing_height(0.004, 0.05, 0.25)  # the swing's last target, 1.5 mm up
     assert last != 0.0
     times = np.linspace(0.0, DOUBLE_SUPPORT, 11)
     heights = np.array([rule.stance_height(t) for t in times])

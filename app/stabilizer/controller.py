@@ -150,6 +150,7 @@ class WholeBodyController:
         self._stance = stance
         q = self.ik.reset(soles["left"], soles["right"], com_xy)[self._ik_order]
         self.swing.start(soles[other_foot(stance)][:2, 3])
+        self.landing.start_swing()
         if self.flywheel is not None:
             self.flywheel.reset()
         self._targets = (q, q)
@@ -201,6 +202,7 @@ class WholeBodyController:
 
     def _start_swing(self, stance: Foot, swing: Foot) -> None:
         self.swing.start(self.model.sole_frame(swing)[0][:2])
+        self.landing.start_swing()
         _, rotation = self.model.sole_frame(stance)
         self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
         self._stance = stance
@@ -220,7 +222,9 @@ class WholeBodyController:
         if command.double_support:
             stance_height = self.landing.stance_height(time_since_step)
         else:
-            position[2] = self.landing.swing_height(position[2], landing_time - time_since_step)
+            position[2] = self.landing.swing_height(
+                position[2], landing_time - time_since_step, time_since_step
+            )
         foothold = np.array([*command.stance.position, stance_height])
         return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position)}
 

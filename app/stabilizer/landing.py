@@ -6,7 +6,10 @@ Two rules on the height of the sole targets given to the IK:
   time the swing sole's target sinks to ``depth`` below the ground, so that a sole
   tracking a few millimetres high still touches down by the step (a late touchdown
   leaves the CoP on the old foot), and past that time it goes on down at
-  ``TOUCHDOWN_SPEED`` until the sole touches (the planner's jump waits for that);
+  ``TOUCHDOWN_SPEED`` until the sole touches (the planner's jump waits for that). The
+  rule counts the time since the landing first fell due itself: while the planner
+  waits for the touchdown it keeps announcing the step for the next tick, so the time
+  left it reports never falls below one tick;
 * continuity at the step: the new stance sole's target starts where the swing
   sole's last target was and reaches the ground by the end of the double support
   (a target that jumped there in one tick kicked the old foot off the ground: 2.6 m g
@@ -17,7 +20,7 @@ from __future__ import annotations
 
 WINDOW = 0.1  # [s] before the planned landing over which the target sinks
 # [m/s] downwards past the planned landing until the sole touches (IHMC's swing
-# parameters use 0.1-0.3; 0.3 against 0.1 on G1's development pushes: 91 and 90 recovered)
+# parameters use 0.1-0.3; 0.3 against 0.1 on G1's development pushes: 98 and 95 recovered)
 TOUCHDOWN_SPEED = 0.3
 
 
@@ -33,17 +36,25 @@ class Landing:
         self.depth = depth
         self.double_support = double_support
         self._last_height = 0.0  # [m] the swing sole's last target height
+        self._due: float | None = None  # [s] the swing's time at which the landing fell due
 
-    def swing_height(self, profile: float, time_to_landing: float) -> float:
+    def start_swing(self) -> None:
+        """A new swing begins: its landing is not due yet."""
+        self._due = None
+
+    def swing_height(self, profile: float, time_to_landing: float, time_since_step: float) -> float:
         """Target height [m] of the swing sole.
 
         Args:
             profile: The swing trajectory's height [m].
             time_to_landing: Time left until the planned landing [s].
+            time_since_step: Time since the swing began [s].
         """
         sink = self.depth * min(max(1.0 - time_to_landing / WINDOW, 0.0), 1.0)
-        if time_to_landing < 0.0:  # a late touchdown: on down until the sole touches
-            sink -= TOUCHDOWN_SPEED * time_to_landing
+        if time_to_landing < 0.0 and self._due is None:
+            self._due = time_since_step + time_to_landing
+        if self._due is not None:  # a late touchdown: on down until the sole touches
+            sink += TOUCHDOWN_SPEED * max(time_since_step - self._due, 0.0)
         self._last_height = profile - sink
         return self._last_height
 
