@@ -7,9 +7,9 @@ Two rules on the height of the sole targets given to the IK:
   tracking a few millimetres high still touches down by the step (a late touchdown
   leaves the CoP on the old foot), and past that time it goes on down at
   ``TOUCHDOWN_SPEED`` until the sole touches (the planner's jump waits for that). The
-  rule counts the time since the landing first fell due itself: while the planner
-  waits for the touchdown it keeps announcing the step for the next tick, so the time
-  left it reports never falls below one tick;
+  rule times that wait from when the landing first fell due: while the planner waits it
+  announces the held step at the current tick, so the time left it gives never falls
+  below minus one tick;
 * continuity at the step: the new stance sole's target starts where the swing
   sole's last target was and reaches the ground by the end of the double support
   (a target that jumped there in one tick kicked the old foot off the ground: 2.6 m g
