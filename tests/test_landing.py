@@ -42,9 +42,10 @@ def test_the_swing_target_sinks_to_the_depth_by_the_landing_time_and_not_before(
 
 
 def test_a_late_touchdown_sinks_while_the_planner_waits_for_it():
-    """While the planner waits for the touchdown it announces the step one tick ahead at
-    every tick: the time left stays at minus one tick, and the target still goes on down
-    at the touchdown speed from the planned landing time, until a new swing begins."""
+    """While the planner waits for the touchdown it announces the held step at the current
+    tick: the time left to the controller's next tick stays at minus one tick, and the
+    target still goes on down at the touchdown speed from the planned landing time, until
+    a new swing begins."""
     rule = landing()
     profile, tick, landing_time = 0.0, 0.01, 0.3
     rule.swing_height(profile, 0.0, landing_time)
