@@ -7,7 +7,7 @@ import pytest
 
 from kinematics.pendulum import rotational_height
 from kinematics.reach import holds, lateral_reach, stance
-from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height
+from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_height, swing_yaw
 from kinematics.whole_body_ik import KNEE_MARGIN, WholeBodyIK, leg_joints, sole_pose
 from planner.exceptions import ParameterError
 from robots import get_robot
@@ -115,6 +115,19 @@ def test_swing_height_profile():
     assert swing_height(0.05, 0.1, 0.8, 0.06) == 0.0
     assert swing_height(0.45, 0.1, 0.8, 0.06) == pytest.approx(0.06)
     assert swing_height(0.8, 0.1, 0.8, 0.06) == pytest.approx(0.0)
+
+
+def test_the_swing_yaw_leaves_where_the_foot_stood_and_lands_on_the_heading():
+    lift_off, landing, start = 0.1, 0.45, 0.2  # [s], [s], [rad]
+    times = np.linspace(0.0, 0.6, 61)
+    yaws = np.array([swing_yaw(t, lift_off, landing, start, 0.0) for t in times])
+    assert np.all(yaws[times <= lift_off] == start)  # still loaded in the double support
+    assert np.all(yaws[times >= landing] == 0.0)
+    assert np.all(np.diff(yaws) <= 0.0)
+    assert np.max(np.abs(np.diff(yaws))) <= start * 0.01 / (landing - lift_off) + 1e-12
+    # The shorter way round: from 170 deg to -170 deg through 180 deg.
+    half = swing_yaw(0.275, lift_off, landing, np.radians(170.0), np.radians(-170.0))
+    assert half == pytest.approx(np.pi)
 
 
 def test_swing_acceleration_bound_and_descent_funnel():

@@ -31,7 +31,7 @@ from app.stabilizer.wrench_distribution import (
     distribute_wrench,
 )
 from kinematics.robot_model import RobotModel
-from kinematics.swing_foot import SwingFootTrajectory, SwingTiming
+from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_yaw
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 from planner.exceptions import ParameterError
@@ -125,7 +125,8 @@ class WholeBodyController:
         self._acceleration = np.zeros(len(self.model.joint_names))
         self._ik_momentum: NDArray[np.float64] | None = None
         self._motion_momentum_rate = np.zeros(2)
-        self._stance_yaw = 0.0
+        self._stance_yaw = 0.0  # [rad] the stance sole's yaw when it landed
+        self._swing_start_yaw = 0.0  # [rad] the swing sole's yaw when it lifted off
         self.planned_cop = np.array(com_xy, dtype=float)
         self.planned_forces: dict[Foot, float] = {}
         self.sole_targets: dict[Foot, NDArray[np.float64]] = {
@@ -201,6 +202,7 @@ class WholeBodyController:
         return self.state
 
     def _start_swing(self, stance: Foot, swing: Foot) -> None:
+        self._swing_start_yaw = self._stance_yaw  # the old stance sole's target
         self.swing.start(self.model.sole_frame(swing)[0][:2])
         self.landing.start_swing()
         _, rotation = self.model.sole_frame(stance)
@@ -211,7 +213,8 @@ class WholeBodyController:
         self, command: PlannerOutput, stance: Foot, swing: Foot
     ) -> dict[Foot, NDArray[np.float64]]:
         """4x4 targets of both soles: the stance sole on the planner's foothold, the
-        swing sole on its trajectory to the announced step, with the landing rules."""
+        swing sole on its trajectory to the announced step, with the landing rules, and
+        turning from the yaw it stood at to the planner's heading (world x) over the swing."""
         dt = self.period
         time_since_step = command.time_since_step + dt
         landing_time = command.next_step_time - (command.time - command.time_since_step)
@@ -226,7 +229,14 @@ class WholeBodyController:
                 position[2], landing_time - time_since_step, time_since_step
             )
         foothold = np.array([*command.stance.position, stance_height])
-        return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position)}
+        yaw = swing_yaw(
+            time_since_step,
+            self.swing.timing.double_support,
+            landing_time,
+            self._swing_start_yaw,
+            0.0,
+        )
+        return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position, yaw)}
 
     def _solve_ik(
         self,
