@@ -95,9 +95,8 @@ def swing_yaw(
     ``lift_off``, then turning at a constant rate the shorter way to ``end``, reached at
     ``landing``.
 
-    A target that jumped to ``end`` at the step twisted a foot still loaded in the double
-    support, and the twist spun the new stance foot (measured on G1 after a push that
-    yawed it 20 deg: the feet stayed 9-14 deg off the heading for 6 s).
+    A target that jumped to ``end`` at the step twisted the foot while it was still loaded
+    in the double support and spun the new stance foot (docs/notes/2026-12-05-swing-yaw.md).
     """
     arrival = start + math.remainder(end - start, 2.0 * math.pi)  # end, the shorter way
     progress = min(max((time_since_step - lift_off) / max(landing - lift_off, 1e-6), 0.0), 1.0)
