@@ -276,6 +276,27 @@ def test_same_commands_give_the_same_result(pushed_runs):
     np.testing.assert_array_equal(first[0], second[0])
 
 
+def test_a_reset_backend_runs_as_a_new_one_after_a_fall(pushed_runs, tmp_path_factory):
+    """A bisection runs many pushes on one backend: after a fall and a reset the same run
+    ends bit for bit as on a new backend (the contact points the fall left behind once
+    warm-started the next run's contacts, and a push that G1 recovered on a new backend
+    was lost after earlier trials)."""
+    with cache_for_module(tmp_path_factory):
+        instance = PyBulletBackend("g1")
+    try:
+        state = instance.reset(STANDING)
+        stand(instance, state, 1.5, lambda t: np.array([0.0, 400.0]) * (0.2 <= t < 0.3))
+        assert instance.fall_status().fell
+
+        state = instance.reset(STANDING)
+        push = lambda t: np.array([60.0, 30.0]) if 0.3 <= t < 0.4 else np.zeros(2)  # noqa: E731
+        state = stand(instance, state, 1.0, push)
+        final = np.concatenate([state.com_position, state.com_velocity])
+    finally:
+        instance.close()
+    np.testing.assert_array_equal(final, pushed_runs[0][0])
+
+
 def test_the_physics_log_observes_without_changing_the_run(pushed_runs):
     """A run with the log ends in the state of the same run without it, bit for bit."""
     plain, _, logged = pushed_runs

@@ -120,7 +120,8 @@ class SimulatedRobot:
         base_angular_velocity: NDArray[np.float64] | None = None,
         joint_velocities: Mapping[str, float] | None = None,
     ) -> None:
-        """Teleport the robot to a configuration of its URDF base frame.
+        """Teleport the robot to a configuration of its URDF base frame, with no contact
+        remembered from before (a run after it goes as on a new world).
 
         Args:
             base_position: Base frame origin [m].
@@ -130,6 +131,10 @@ class SimulatedRobot:
             base_angular_velocity: Base angular velocity in the world [rad/s].
             joint_velocities: Joint name -> velocity [rad/s] (missing: 0).
         """
+        # Clear the contact points of the last run first: they warm-start the solver and
+        # anchor friction, and a run after a reset went otherwise than on a new world.
+        self.client.resetBasePositionAndOrientation(self.body, [0.0, 0.0, 100.0], [0, 0, 0, 1])
+        self.client.performCollisionDetection()
         position, orientation = self.client.multiplyTransforms(
             list(base_position), list(base_quaternion_xyzw), *self._base_inertial
         )
