@@ -193,8 +193,9 @@ def test_the_feedforward_torques_hold_the_posture_the_pd_alone_lets_sag():
     rms_without = np.sqrt(np.mean(without_ff**2))
     assert rms_with < 0.1 * rms_without, f"{rms_with=} {rms_without=}"
     # Without it the knees, which carry the weight, sag until kp e carries the load:
-    # e = -tau_ff / kp (measured within 1 %).
+    # e = -tau_ff / kp, for the two knees together within 2 % (measured 1.4 %; the split
+    # between them drifts by 10 % as the robot, standing on its PD alone, leans).
     knees = backend.controller.model.index_of(["left_knee_joint", "right_knee_joint"])
     sag = -feedforward.mean(axis=0)[knees] / backend.controller.stiffness[knees]
     assert np.all(np.abs(sag) > np.radians(0.3))
-    np.testing.assert_allclose(without_ff.mean(axis=0)[knees], sag, rtol=0.1)
+    np.testing.assert_allclose(without_ff.mean(axis=0)[knees].sum(), sag.sum(), rtol=0.02)
