@@ -7,7 +7,7 @@ when a change of behaviour is meant, and say so in the commit:
 
     python tests/behaviour_cases.py --record
 
-Each case runs in a child process with CPU-dispatch pinned (ENVIRONMENT): OpenBLAS
+Each case runs in a child process with CPU-dispatch pinned (tests/kernels.py): OpenBLAS
 and numpy pick kernels by CPU, and their sums round differently.
 """
 
@@ -21,15 +21,9 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from kernels import ENVIRONMENT
 
 RECORD = Path(__file__).parent / "data" / "behaviour.npz"
-ENVIRONMENT = {
-    "OPENBLAS_CORETYPE": "Haswell",
-    "OPENBLAS_NUM_THREADS": "1",
-    "OMP_NUM_THREADS": "1",
-    "NPY_DISABLE_CPU_FEATURES": "AVX512F AVX512CD AVX512_SKX AVX512_CLX AVX512_CNL "
-    "AVX512_ICL AVX512_SPR",
-}
 CASES = {
     # (model, robot, built-in scenario or one push as `rsg run --push`, duration [s]):
     # the paper's Fig. 6 on its point mass; G1 pushed forward and sideways in swing.
@@ -60,7 +54,8 @@ def run_case(name: str) -> dict[str, np.ndarray]:
 
 
 def run_in_child(name: str, out: Path) -> dict[str, np.ndarray]:
-    """:func:`run_case` in a fresh Python process with :data:`ENVIRONMENT`."""
+    """:func:`run_case` in a fresh Python process with the pinned kernels
+    (:data:`kernels.ENVIRONMENT`)."""
     env = {**os.environ, **ENVIRONMENT}
     subprocess.run(
         [sys.executable, __file__, "--case", name, "--out", str(out)], check=True, env=env

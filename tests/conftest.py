@@ -3,7 +3,12 @@ session; hand-made planner commands and a DCM feedback for full-robot tests (the
 planner's part, without the planner); the cache of derived URDFs in the session's
 temporary folder; servers run as subprocesses."""
 
+# ruff: noqa: E402 (the kernels are pinned before numpy is imported)
 from __future__ import annotations
+
+import kernels
+
+kernels.pin()  # before numpy loads
 
 import socket
 import subprocess
