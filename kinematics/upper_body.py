@@ -3,11 +3,11 @@
 The planner commands a rate of change of centroidal angular momentum hdot [N m].
 A robot realises it by turning its upper body, and only so far: the torso and the
 arms have a range of motion, so the angular momentum they can hold is bounded.
-This module turns a horizontal angular momentum target h* [N m s] into joint
-velocities of the upper-body joints (waist roll and pitch, shoulder pitch and roll
-on G1) and integrates them into offsets added to the whole-body IK's joint targets.
+This module turns an angular momentum target h* [N m s] into joint velocities of
+the upper-body joints (waist yaw, roll and pitch, shoulder pitch and roll on G1) and
+integrates them into offsets added to the whole-body IK's joint targets.
 
-Each call, with A the angular rows (x, y) of the centroidal momentum matrix
+Each call, with A the angular rows (x, y, z) of the centroidal momentum matrix
 restricted to the upper-body joints (from the IK model at its current
 configuration),
 
@@ -30,6 +30,16 @@ walking). So the target is the band-passed integral of hdot,
 with T_r = ``return_time``: the low-passed part b and whatever exceeds the bound
 stay with the CoP (the caller's CoM plan keeps them as a CMP shift), the rest is
 carried by the torso and the arms.
+
+The upper body also takes back a share ``cancel`` of the high-passed angular momentum
+of the rest of the motion (the legs' swing), about all three axes. About z the planner
+commands nothing, so there the target is only that share: the waist and the arms turn
+against a swinging leg, as in Kajita et al., "Resolved momentum control: humanoid motion
+planning based on the linear and angular momentum" (IROS 2003), which keeps the whole
+body's angular momentum about z near zero. Otherwise the stance sole's friction has to
+hold the leg's yaw moment: after a fast outward step on G1 the stance foot turned 5 deg
+about z and the swing sole landed 4.5 cm off its target
+(docs/notes/2026-12-05-yaw-momentum.md).
 """
 
 from __future__ import annotations
@@ -43,7 +53,7 @@ from planner.exceptions import ParameterError
 
 
 class UpperBodyFlywheel:
-    """Upper-body joint offsets that realise a horizontal angular momentum target.
+    """Upper-body joint offsets that realise an angular momentum target.
 
     Args:
         robot: placo ``RobotWrapper`` of the IK model (its centroidal map and joint
@@ -55,7 +65,7 @@ class UpperBodyFlywheel:
             offsets' return to zero.
         max_momentum: h_max, bound on the carried angular momentum [N m s].
         cancel: c, fraction of the high-passed angular momentum of the rest of the
-            motion (the legs' swing) the upper body takes back (see
+            motion (the legs' swing) the upper body takes back, about x, y and z (see
             :meth:`follow_rate`).
         damping: lambda of the damped pseudo-inverse [(kg m^2)^2].
     """
@@ -101,18 +111,18 @@ class UpperBodyFlywheel:
         self._low = np.maximum(-max_offset, np.asarray(model.lowerPositionLimit)[q_index] - posture)
         self._high = np.minimum(max_offset, np.asarray(model.upperPositionLimit)[q_index] - posture)
         self.offsets = np.zeros(len(self.joints))
-        self.momentum = np.zeros(2)
-        self.target = np.zeros(2)  # h* [N m s]
+        self.momentum = np.zeros(3)  # of the offsets' last motion, x y z [N m s]
+        self.target = np.zeros(2)  # h*, horizontal [N m s]
         self.steady_rate = np.zeros(2)  # b, the part of hdot left to the CoP [N m]
-        self.steady_motion = np.zeros(2)  # low-passed momentum of the other motion [N m s]
+        self.steady_motion = np.zeros(3)  # low-passed momentum of the other motion [N m s]
 
     def reset(self) -> None:
         """Back to the standing posture, at rest."""
         self.offsets = np.zeros(len(self.joints))
-        self.momentum = np.zeros(2)
+        self.momentum = np.zeros(3)
         self.target = np.zeros(2)
         self.steady_rate = np.zeros(2)
-        self.steady_motion = np.zeros(2)
+        self.steady_motion = np.zeros(3)
 
     def follow_rate(
         self,
@@ -126,7 +136,7 @@ class UpperBodyFlywheel:
             rate: Commanded horizontal hdot [N m], (2,).
             dt: Time step [s].
             motion_momentum: Angular momentum of the rest of the whole-body motion
-                [N m s], (2,); with ``cancel`` > 0, that fraction of its
+                [N m s], (3,); with ``cancel`` > 0, that fraction of its
                 high-passed part (time constant ``return_time``) is added with
                 the opposite sign to what the upper body carries.
 
@@ -138,12 +148,12 @@ class UpperBodyFlywheel:
         self.steady_rate += fraction * (rate - self.steady_rate)
         self.target += dt * (rate - self.steady_rate) - fraction * self.target
         np.clip(self.target, -self.max_momentum, self.max_momentum, out=self.target)
-        wanted = self.target
+        wanted = np.array([*self.target, 0.0])  # hdot has no z part
         if self.cancel > 0.0 and motion_momentum is not None:
             motion = np.asarray(motion_momentum, float)
             self.steady_motion += fraction * (motion - self.steady_motion)
             wanted = np.clip(
-                self.target - self.cancel * (motion - self.steady_motion),
+                wanted - self.cancel * (motion - self.steady_motion),
                 -self.max_momentum,
                 self.max_momentum,
             )
@@ -153,7 +163,7 @@ class UpperBodyFlywheel:
         """Move the offsets for ``dt`` toward carrying ``target``.
 
         Args:
-            target: Horizontal angular momentum h* for the upper body [N m s], (2,).
+            target: Angular momentum for the upper body [N m s], (3,): x, y, z.
             dt: Time step [s].
 
         Returns:
@@ -162,10 +172,13 @@ class UpperBodyFlywheel:
         """
         if not dt > 0.0:
             raise ParameterError("dt", dt, "> 0 s")
+        target = np.asarray(target, float)
+        if target.shape != (3,):
+            raise ParameterError("target", target.shape, "(3,): x, y, z [N m s]")
         centroidal = np.asarray(self.robot.centroidal_map(), float)
-        a = centroidal[3:5, self._v_index]
-        gram = a @ a.T + self.damping * np.eye(2)
-        velocity = a.T @ np.linalg.solve(gram, np.asarray(target, float))
+        a = centroidal[3:6, self._v_index]
+        gram = a @ a.T + self.damping * np.eye(3)
+        velocity = a.T @ np.linalg.solve(gram, target)
         velocity -= self.offsets / self.return_time
         new = np.clip(self.offsets + velocity * dt, self._low, self._high)
         self.momentum = a @ ((new - self.offsets) / dt)

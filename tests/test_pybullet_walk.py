@@ -135,6 +135,39 @@ def test_g1_catches_a_stance_side_push_with_an_outward_step_wider_than_0_4_m():
     assert max(errors[-5:]) < LANDING_TOLERANCE
 
 
+def test_a_fast_outward_step_does_not_turn_the_stance_foot():
+    """7.5 N s to the left, early in the right foot's single support (development push 24
+    of seed 1): G1 steps its left foot out 0.3 m in 0.25 s. The upper body turns against
+    the swinging leg's momentum about z (kinematics/upper_body.py), so the stance sole's
+    yaw changes less than 1 deg over each single support of the 2 s after the push
+    (measured 0.5 deg; taking back only the horizontal momentum, 3.0 deg on the wide
+    step, and its swing sole landed 4.5 cm off its target)."""
+    push = Push(3.2096, np.array([-3.1806, 6.7591]), 0.107)
+    backend, config, initial = build_robot_backend("g1", "rsg", ())
+    loop = ClosedLoop(
+        backend, config, Scenario("push", push.time + 2.0, (push,), reference_mass=None), initial
+    )
+    turns: list[float] = []
+    first = last = None
+    try:
+        for _ in range(round((push.time + 2.0) / loop.period)):
+            out = loop.tick()
+            assert not backend.fall_status().fell
+            _, rotation = backend.controller.model.sole_frame(out.stance.foot)
+            yaw = float(np.degrees(np.arctan2(rotation[1, 0], rotation[0, 0])))
+            if out.double_support:  # a single support ended: its stance foot's turn
+                if first is not None and out.time > push.time:
+                    turns.append(last - first)
+                first = None
+                continue
+            first = yaw if first is None else first
+            last = yaw
+    finally:
+        backend.close()
+    assert len(turns) >= 3
+    assert max(abs(turn) for turn in turns) < 1.0, turns
+
+
 def test_the_feet_turn_back_to_the_heading_after_a_push_that_yaws_them():
     """IHMC's outward push at 0.76 m g (24.8 N s over 0.1 s in the double support, 3.15 s)
     spins G1's feet 10-20 deg off the planner's heading. Each swing sole leaves the

@@ -51,16 +51,16 @@ def centroidal_angular_momentum(ik, joints, joint_velocity):
 def test_the_offsets_carry_the_target_angular_momentum(ik):
     joints = list(G1.upper_body_joints)
     flywheel = UpperBodyFlywheel(ik.robot, joints, posture(joints), return_time=100.0)
-    target = np.array([0.15, -0.2])  # [N m s]
+    target = np.array([0.15, -0.2, 0.0])  # [N m s]
     before = flywheel.offsets.copy()
     flywheel.update(target, DT)
     joint_velocity = (flywheel.offsets - before) / DT
     realised = centroidal_angular_momentum(ik, joints, joint_velocity)
-    np.testing.assert_allclose(realised[:2], target, atol=0.01 * np.linalg.norm(target))
-    np.testing.assert_allclose(flywheel.momentum, realised[:2], atol=1e-9)
+    np.testing.assert_allclose(realised, target, atol=0.01 * np.linalg.norm(target))
+    np.testing.assert_allclose(flywheel.momentum, realised, atol=1e-9)
     # Mostly the waist: it has the inertia (about 1 kg m^2 against 0.07 for an arm).
     waist = [joints.index("waist_roll_joint"), joints.index("waist_pitch_joint")]
-    assert np.abs(joint_velocity[waist]).min() > 5 * np.abs(np.delete(joint_velocity, waist)).max()
+    assert np.abs(joint_velocity[waist]).min() > 3 * np.abs(np.delete(joint_velocity, waist)).max()
 
 
 def test_the_offsets_stay_within_their_range_and_then_carry_nothing(ik):
@@ -74,7 +74,7 @@ def test_the_offsets_stay_within_their_range_and_then_carry_nothing(ik):
     lower = np.asarray(model.lowerPositionLimit)[q_index]
     upper = np.asarray(model.upperPositionLimit)[q_index]
     for _ in range(300):  # 1 N m s held for 3 s: the waist would turn ~3 rad
-        flywheel.update(np.array([1.0, 1.0]), DT)
+        flywheel.update(np.array([1.0, 1.0, 1.0]), DT)
         assert np.all(np.abs(flywheel.offsets) <= 0.3 + 1e-12)
         assert np.all(stand + flywheel.offsets >= lower - 1e-12)
         assert np.all(stand + flywheel.offsets <= upper + 1e-12)
@@ -104,6 +104,27 @@ def test_a_steady_rate_is_left_to_the_cop_and_a_pulse_is_carried_then_returned(i
     assert np.all(np.abs(flywheel.offsets) < 0.1 * abs(pitch))
 
 
+def test_the_upper_body_turns_against_the_legs_yaw_momentum(ik):
+    """A leg swung outwards carries angular momentum about z; the waist and the arms take
+    back the share ``cancel`` of it (Kajita et al. 2003), the waist's yaw most, so the
+    stance sole's friction holds less of it."""
+    joints = list(G1.upper_body_joints)
+    flywheel = UpperBodyFlywheel(
+        ik.robot, joints, posture(joints), return_time=0.5, max_momentum=2.0, cancel=1.0
+    )
+    before = flywheel.offsets.copy()
+    legs = np.array([0.0, 0.0, 0.3])  # [N m s]: a swing's, from rest
+    flywheel.follow_rate(np.zeros(2), DT, legs)
+    joint_velocity = (flywheel.offsets - before) / DT
+    realised = centroidal_angular_momentum(ik, joints, joint_velocity)
+    high_passed = legs * (1.0 - DT / 0.5)  # what the band-pass leaves after one tick
+    np.testing.assert_allclose(realised, -high_passed, atol=0.02 * np.linalg.norm(legs))
+    np.testing.assert_allclose(flywheel.momentum, realised, atol=1e-9)
+    yaw = joints.index("waist_yaw_joint")
+    assert abs(joint_velocity[yaw]) == np.abs(joint_velocity).max()
+    assert joint_velocity[yaw] < 0.0  # against the legs' positive momentum about z
+
+
 def test_the_upper_body_takes_back_part_of_the_legs_swinging_momentum(ik):
     """A 1.25 Hz oscillation of the rest of the motion's momentum (the legs' swing) is
     carried back by the upper body at the fraction ``cancel``; its mean is not."""
@@ -114,7 +135,7 @@ def test_the_upper_body_takes_back_part_of_the_legs_swinging_momentum(ik):
     carried, legs = [], []
     for tick in range(560):
         time = tick * DT
-        motion = np.array([0.2 + 0.4 * np.sin(2 * np.pi * 1.25 * time), 0.0])  # [N m s]
+        motion = np.array([0.2 + 0.4 * np.sin(2 * np.pi * 1.25 * time), 0.0, 0.0])  # [N m s]
         flywheel.follow_rate(np.zeros(2), DT, motion)
         carried.append(flywheel.momentum[0])
         legs.append(motion[0] - 0.2)

@@ -249,7 +249,7 @@ class WholeBodyController:
         support = "both" if command.double_support else command.stance.foot
         offsets = None
         if self.flywheel is not None:
-            rest = self.ik.angular_momentum[:2] - self.flywheel.momentum
+            rest = self.ik.angular_momentum - self.flywheel.momentum  # x, y, z [N m s]
             offsets = self.flywheel.follow_rate(command.angular_momentum_rate_feedback, dt, rest)
         try:
             q = self.ik.solve(
