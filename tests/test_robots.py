@@ -272,3 +272,26 @@ def test_physics_time_step_is_validated(value):
     with pytest.raises(ParameterError) as error:
         dataclasses.replace(get_robot("g1"), physics_time_step=value)
     assert error.value.field == "physics_time_step"
+
+
+@pytest.mark.parametrize("name", ["g1", "talos"])
+def test_each_leg_is_the_chain_from_the_pelvis_to_its_ankle(name):
+    """``RobotModel.leg_joints``: six joints per leg, disjoint, moving only their own
+    foot, and ending with the two joints nearest the sole (the ankle's)."""
+    from kinematics.robot_model import RobotModel
+
+    model = RobotModel(get_robot(name))
+    legs = {foot: model.leg_joints(foot) for foot in ("left", "right")}
+    assert all(len(leg) == 6 for leg in legs.values())
+    assert not set(legs["left"]) & set(legs["right"])
+    for foot, leg in legs.items():
+        assert all(model.is_ankle(model.joint_names[i]) for i in leg[-2:])
+        # Moving this leg's joints moves its own sole and not the other one.
+        q = np.concatenate([[0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0], np.zeros(len(model.joint_names))])
+        model.update(q, np.zeros(model.nv))
+        before = {f: model.sole_frame(f)[0] for f in ("left", "right")}
+        q[7 + leg] += 0.1
+        model.update(q, np.zeros(model.nv))
+        other = "right" if foot == "left" else "left"
+        assert np.linalg.norm(model.sole_frame(foot)[0] - before[foot]) > 0.01
+        np.testing.assert_allclose(model.sole_frame(other)[0], before[other], atol=1e-12)

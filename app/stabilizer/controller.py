@@ -41,8 +41,8 @@ from planner.types import Foot, MeasuredState, PlannerOutput, other_foot
 from robots.description import RobotDescription
 
 CONTACT_LOAD = 0.05  # [-, of m g] a foot carrying more is on the ground
-ACCELERATION_FILTER = 0.02  # [s] low-pass of the IK's joint accelerations
-ACCELERATION_LIMIT = 50.0  # [rad/s^2] bound on the feed-forward joint accelerations
+ACCELERATION_FILTER = 0.02  # [s] low-pass of the IK's joint accelerations (not the swing leg's)
+ACCELERATION_LIMIT = 50.0  # [rad/s^2] bound on the feed-forward joint accelerations (idem)
 MOMENTUM_FILTER = 0.05  # [s] low-pass of the IK motion's angular momentum rate
 SWING_ACCELERATION = 20.0  # [m/s^2] bound on the swing sole's re-planned approach
 SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
@@ -87,6 +87,7 @@ class WholeBodyController:
         flywheel = config.flywheel_momentum > 0.0 and bool(description.upper_body_joints)
         self.ik = WholeBodyIK(description, upper_body=flywheel)
         self._ik_order = np.array([self.ik.joint_names.index(n) for n in self.model.joint_names])
+        self._legs = {foot: self.model.leg_joints(foot) for foot in ("left", "right")}
         self.flywheel = None
         if flywheel:
             self.flywheel = UpperBodyFlywheel(
@@ -266,8 +267,14 @@ class WholeBodyController:
             (momentum - previous) / dt - self._motion_momentum_rate
         )
         raw = (q - 2.0 * self._targets[0] + self._targets[1]) / dt**2
-        raw = np.minimum(np.maximum(raw, -ACCELERATION_LIMIT), ACCELERATION_LIMIT)
-        self._acceleration += min(dt / ACCELERATION_FILTER, 1.0) * (raw - self._acceleration)
+        gain = np.full(len(q), min(dt / ACCELERATION_FILTER, 1.0))
+        limit = np.full(len(q), ACCELERATION_LIMIT)
+        if not command.double_support:
+            # The swing leg's targets follow its planned trajectory: its accelerations are
+            # the plan's, and low-passed they come late and the sole overshoots its target.
+            swing = self._legs[other_foot(command.stance.foot)]
+            gain[swing], limit[swing] = 1.0, np.inf
+        self._acceleration += gain * (np.clip(raw, -limit, limit) - self._acceleration)
         return q
 
     def _contact_wrenches(
