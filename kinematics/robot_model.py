@@ -59,8 +59,11 @@ class RobotModel:
         # Each leg: the joints from the floating base to its ankle link.
         self._legs = {
             foot: np.array(
-                [joint - 2 for joint in self.model.supports[self.model.frames[frame].parentJoint]
-                 if joint > 1],
+                [
+                    joint - 2
+                    for joint in self.model.supports[self.model.frames[frame].parentJoint]
+                    if joint > 1
+                ],
                 dtype=np.intp,
             )
             for foot, frame in self._ankle_frames.items()
