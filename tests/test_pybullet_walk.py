@@ -148,8 +148,9 @@ def test_a_fast_outward_step_does_not_turn_the_stance_foot():
     yaw changes less than 2.5 deg over each single support of the 2 s after the push
     (measured 1.8 deg on the wide step that follows, since the swing leg's accelerations
     are fed forward unfiltered; 0.5 deg before. Measured over-turning: the upper body
-    taking back all of the legs' momentum about z, 3.5 deg; turning with it, 3.1 deg;
-    before 510e58d, taking back only the horizontal momentum, 3.0 deg)."""
+    taking back all of the legs' momentum about z, 3.5 deg; turning with the legs instead
+    of against them, 3.1 deg; before 510e58d, taking back only the horizontal momentum,
+    3.0 deg)."""
     push = Push(3.2096, np.array([-3.1806, 6.7591]), 0.107)
     turns: list[float] = []
     yaws: list[float] = []  # the stance sole's, over the current single support [deg]
@@ -172,7 +173,8 @@ def test_a_fast_outward_step_does_not_turn_the_stance_foot():
 
 def test_a_swing_sole_sent_elsewhere_by_a_push_follows_its_target():
     """25 N s forward and to the left at 2.6 s, mid-swing: the planner moves the left
-    foot's step 0.18 m further and 0.13 m outward, to be taken 0.2 s later. The swing leg
+    foot's step 8 cm further forward and 13 cm further out, to be taken 0.2 s after the
+    push instead of at 3.1 s. The swing leg
     gets its planned accelerations as feed-forward torque, so its sole stays within 3.8
     cm of the IK's target and 1.6 cm on average until it lands (measured 3.0 and 1.3 cm;
     with its feed-forward low-passed as the stance leg's is, 4.8 and 1.9 cm, and the sole
