@@ -56,18 +56,6 @@ class RobotModel:
                 self.model.names[joint],
                 self.model.names[self.model.parents[joint]],
             }
-        # Each leg: the joints from the floating base to its ankle link.
-        self._legs = {
-            foot: np.array(
-                [
-                    joint - 2
-                    for joint in self.model.supports[self.model.frames[frame].parentJoint]
-                    if joint > 1
-                ],
-                dtype=np.intp,
-            )
-            for foot, frame in self._ankle_frames.items()
-        }
         self.q = pinocchio.neutral(self.model)
         self.v = np.zeros(self.model.nv)
 
@@ -78,11 +66,6 @@ class RobotModel:
     def is_ankle(self, joint: str) -> bool:
         """Whether ``joint`` is one of the two joints nearest a sole."""
         return joint in self._ankle_joints
-
-    def leg_joints(self, foot: str) -> NDArray[np.intp]:
-        """Positions in ``joint_names`` of ``foot``'s leg: the joints from the floating
-        base to its ankle link."""
-        return self._legs[foot].copy()
 
     def index_of(self, names: Sequence[str]) -> NDArray[np.intp]:
         """Positions in ``joint_names`` of each of ``names``."""

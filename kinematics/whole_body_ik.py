@@ -100,16 +100,17 @@ def humanoid_robot(description: RobotDescription) -> Any:
 
 
 def leg_joints(model: Any) -> dict[str, list[str]]:
-    """The legs' joints of a pinocchio ``model``: ``"chains"``, every joint from the
-    floating base to either sole's link, and ``"knees"``, the joint above each ankle's two
-    (the two joints nearest the sole, as in :class:`kinematics.robot_model.RobotModel`)."""
-    chains: list[str] = []
+    """The legs' joints of a pinocchio ``model``: ``"left"`` and ``"right"``, each leg's
+    joints from the floating base to its sole's link; ``"chains"``, both legs; and
+    ``"knees"``, the joint above each ankle's two (the two joints nearest the sole, as in
+    :class:`kinematics.robot_model.RobotModel`)."""
+    legs: dict[str, list[str]] = {}
     knees: list[str] = []
-    for frame in FOOT_FRAMES.values():
+    for foot, frame in FOOT_FRAMES.items():
         joint = model.frames[model.getFrameId(frame)].parentJoint
-        chains += [model.names[k] for k in model.supports[joint] if k > 1]
+        legs[foot] = [model.names[k] for k in model.supports[joint] if k > 1]
         knees.append(model.names[model.parents[model.parents[joint]]])
-    return {"chains": chains, "knees": knees}
+    return {**legs, "chains": [name for leg in legs.values() for name in leg], "knees": knees}
 
 
 def yaw_rotation(yaw: float) -> NDArray[np.float64]:

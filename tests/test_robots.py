@@ -276,12 +276,16 @@ def test_physics_time_step_is_validated(value):
 
 @pytest.mark.parametrize("name", ["g1", "talos"])
 def test_each_leg_is_the_chain_from_the_pelvis_to_its_ankle(name):
-    """``RobotModel.leg_joints``: six joints per leg, disjoint, moving only their own
-    foot, and ending with the two joints nearest the sole (the ankle's)."""
+    """``kinematics.whole_body_ik.leg_joints`` per foot: six joints per leg, disjoint,
+    moving only their own foot, and ending with the two joints nearest the sole (the
+    ankle's)."""
     from kinematics.robot_model import RobotModel
+    from kinematics.whole_body_ik import humanoid_robot, leg_joints
 
-    model = RobotModel(get_robot(name))
-    legs = {foot: model.leg_joints(foot) for foot in ("left", "right")}
+    description = get_robot(name)
+    model = RobotModel(description)
+    chains = leg_joints(humanoid_robot(description).model)
+    legs = {foot: model.index_of(chains[foot]) for foot in ("left", "right")}
     assert all(len(leg) == 6 for leg in legs.values())
     assert not set(legs["left"]) & set(legs["right"])
     for foot, leg in legs.items():

@@ -33,7 +33,7 @@ from app.stabilizer.wrench_distribution import (
 from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_yaw
 from kinematics.upper_body import UpperBodyFlywheel
-from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
+from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, leg_joints, sole_pose
 from planner.exceptions import ParameterError
 from planner.hybrid_lipm import integrate_lipm
 from planner.parameters import GRAVITY, LipmModel
@@ -87,7 +87,8 @@ class WholeBodyController:
         flywheel = config.flywheel_momentum > 0.0 and bool(description.upper_body_joints)
         self.ik = WholeBodyIK(description, upper_body=flywheel)
         self._ik_order = np.array([self.ik.joint_names.index(n) for n in self.model.joint_names])
-        self._legs = {foot: self.model.leg_joints(foot) for foot in ("left", "right")}
+        legs = leg_joints(self.ik.robot.model)
+        self._legs = {foot: self.model.index_of(legs[foot]) for foot in ("left", "right")}
         self.flywheel = None
         if flywheel:
             self.flywheel = UpperBodyFlywheel(
