@@ -97,6 +97,7 @@ RANGES: dict[str, Range] = {
     "push_hold_time": Range(0.0, 1.0, "s"),
     "push_cmp_threshold": Range(0.0, 1.0, "m", low_open=True),
     "reanchor_time": Range(0.0, 1.0, "s"),
+    "touchdown_window": Range(0.0, 1.0, "s"),
     "dcm_inset": Range(-0.1, 0.1, "m"),
 }
 #: Bound on each coordinate of the ZMP window and of the step bounds [m].
@@ -261,6 +262,11 @@ class RsgParameters:
             |f| c_z / (m g) it causes [m], above which a push counts as under way.
         reanchor_time: Time constant [s] with which o_H moves to a measured stance
             sole (``MeasuredState.stance_sole``); 0: at once.
+        touchdown_window: An extension of D_T for a backend that measures the swing
+            sole's contact (``MeasuredState.swing_contact``): a scheduled timing jump
+            that brings a step forward comes at a touchdown measured at most this long
+            [s] before its time, the swing sole's landing window (a contact earlier is
+            a scrape, not a landing); 0 (the paper): at its time.
         dcm_inset: An extension of (27c) to the DCM [m]: a QP step puts the new stance
             sole's centre line at least this far outside the DCM predicted at the
             step, sigma+ (xi_dcm,y - u_d,y) <= -dcm_inset (see
@@ -293,6 +299,7 @@ class RsgParameters:
     push_hold_time: float = 0.15
     push_cmp_threshold: float = 0.02
     reanchor_time: float = 0.0
+    touchdown_window: float = 0.0
     dcm_inset: float | None = None
     qp_at_timing_jump: bool = True
     announced_foothold: bool = True

@@ -34,7 +34,9 @@ Departures and extensions, one line each (why, flag and measurement:
 - ``announced_foothold``: a nominal jump (D_S) steps onto the foothold announced at the
   tick before, where the swing foot was sent, as a scheduled timing jump does;
 - a backend's swing contact (``MeasuredState.swing_contact``: a due jump waits for the
-  swing sole to touch down, its foothold kept) and stance sole
+  swing sole to touch down, its foothold kept; ``touchdown_window``: a timing jump
+  scheduled before the reference's own jump comes at the touchdown if the sole lands
+  within that window before its time) and stance sole
   (``MeasuredState.stance_sole``: o_H follows it, over ``reanchor_time``).
 
 Controllers in the same framework (``PlannerConfig.controller``): ``rsg``, all of the
@@ -128,6 +130,7 @@ class ReactiveStepGenerator:
         self.push_estimate = np.zeros(2)  # f c_z / (m g): CMP shift by the push [m]
         self.push_duration = 0.0  # time the estimate has been above the threshold [s]
         self._reanchor_target: np.ndarray | None = None  # measured stance sole [m]
+        self._swing_lifted = False  # the swing sole was seen off the ground this swing
 
     def initial_com_state(self) -> tuple[np.ndarray, np.ndarray]:
         """CoM position and velocity [m], [m/s] of the reference at the current state."""
@@ -202,12 +205,21 @@ class ReactiveStepGenerator:
         wait = self._nominal_wait() if nominal_wait is None else nominal_wait
         return min(delay, wait)
 
-    def _schedule(self, xi1: np.ndarray, level: float) -> bool:
-        """Decide a timing jump (D_T) if none is scheduled; True when it is due now."""
+    def _schedule(self, xi1: np.ndarray, level: float, touchdown: bool) -> bool:
+        """Decide a timing jump (D_T) if none is scheduled; True when it is due now, or
+        when the swing sole has just landed within ``touchdown_window`` of it and the
+        jump brings the step forward (a nominal step's time is the reference's jump,
+        so it waits for it)."""
         if self.scheduled_step is None and self._timing_jump(xi1, level):
             self.scheduled_step = self.time_since_step + self._timing_jump_delay()
         due = self.scheduled_step
-        return due is not None and self.time_since_step >= due - 1e-9
+        if due is None:
+            return False
+        left = due - self.time_since_step
+        window = self.config.rsg.touchdown_window
+        if touchdown and left <= window + 1e-9 and left < self._nominal_wait() - 1e-9:
+            return True
+        return left <= 1e-9
 
     def predict(self, xi: np.ndarray, delay: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """State, DCM error and xi1* predicted ``delay`` [s] ahead, before any jump.
@@ -360,7 +372,10 @@ class ReactiveStepGenerator:
 
         step_event: StepEvent | None = None
         qp_infeasible = False
-        timing = self._schedule(xi[:2], level)
+        if measured.swing_contact is False:
+            self._swing_lifted = True
+        touchdown = bool(measured.swing_contact) and self._swing_lifted
+        timing = self._schedule(xi[:2], level, touchdown)
         # A scheduled timing jump keeps its time: the swing foot is on its way there.
         nominal = (
             self.scheduled_step is None
@@ -389,6 +404,7 @@ class ReactiveStepGenerator:
             self.window_start = window_now
             self.time_since_step = 0.0
             self.scheduled_step = None
+            self._swing_lifted = False
             self.reference.jump()
             step_event = StepEvent(
                 time=measured.time,

@@ -30,6 +30,7 @@ PLANNER_FIELDS = (
     "filter_time_constant",
     "step_reaction_time",
     "reanchor_time",
+    "touchdown_window",
 )
 
 
@@ -130,6 +131,9 @@ class RobotDescription:
         reanchor_time: Time constant [s] with which the planner moves its foothold
             to a measured stance sole (``RsgParameters.reanchor_time``; backend
             option ``reanchor_stance``); 0: at once.
+        touchdown_window: How long [s] before a scheduled timing jump's time a
+            measured touchdown of the swing sole brings the jump forward
+            (``RsgParameters.touchdown_window``); 0: the jump keeps its time.
         dcm_inset: The planner's row (27c') [m] (``RsgParameters.dcm_inset``): a QP
             step puts the new sole's centre line at least this far outside the
             predicted DCM; None: (27c) as printed.
@@ -182,6 +186,7 @@ class RobotDescription:
     filter_time_constant: float = 0.05
     step_reaction_time: float = 0.0
     reanchor_time: float = 0.0
+    touchdown_window: float = 0.0
     dcm_inset: float | None = None
     physics_time_step: float = 0.001
     solver_iterations: int = 50

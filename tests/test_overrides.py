@@ -290,6 +290,17 @@ def test_the_reanchor_time_of_a_robot_reaches_its_planner() -> None:
     assert error.value.allowed == "a number in [0, 1] s"
 
 
+def test_the_touchdown_window_of_g1_reaches_its_planner() -> None:
+    """G1's description sets the planner's touchdown_window (Talos keeps it off); on the
+    point mass, which reports no swing contact, --set touchdown_window is refused."""
+    _, config, _ = build_backend("lipm", "g1", "rsg")
+    assert config.rsg.touchdown_window == get_robot("g1").touchdown_window == 0.1
+    assert get_robot("talos").touchdown_window == 0.0
+    with pytest.raises(ParameterError) as error:
+        build_backend("lipm", "g1", "rsg", overrides=(("touchdown_window", "0.05"),))
+    assert error.value.field == "--set touchdown_window"
+
+
 def test_the_solver_iterations_reach_pybullet() -> None:
     """``--set solver_iterations=N`` sets PyBullet's contact and motor solver; a value
     out of range names the field before any run."""

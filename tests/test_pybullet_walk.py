@@ -201,6 +201,36 @@ def test_a_swing_sole_sent_elsewhere_by_a_push_follows_its_target():
     assert float(np.mean(errors)) < 0.016, np.mean(errors)
 
 
+def test_a_sole_landing_before_its_timing_jump_is_stepped_on_at_once():
+    """20 N s forward and to the left as the double support begins (2.3 s): the
+    planner brings the left foot's step forward to 2.65 s, the earliest a swing may
+    land. The sole touches down sooner and the jump comes at that touchdown; waiting
+    for 2.65 s, the sole bounced off the ground, the stance foot rolled 30 deg on its
+    inner edge and the step came at 2.76 s, after which G1 fell (measured)."""
+    push = Push(2.3, np.array([14.14, 14.14]), 0.1)
+    announced: list[float] = []  # the step time announced after the decision [s]
+    steps: list[tuple[float, bool]] = []  # (time [s], swing sole touching a tick before)
+    touching = [False]
+
+    def observe(out: PlannerOutput, backend: Any) -> None:
+        if out.time < push.time + 0.1 or len(steps) > 1:
+            return
+        if out.step is not None:
+            steps.append((out.time, touching[0]))
+        elif not out.double_support:
+            announced.append(out.next_step_time)
+            touching[0] = out.next_step.foot in backend.feet_in_contact()
+
+    scenario = Scenario("push", push.time + 3.0, (push,), reference_mass=None)
+    result, _ = run_g1(scenario, observe=observe)
+    assert not result.fall.fell, result.fall.reason
+    assert result.recovered
+    first, touched = steps[0]
+    assert touched
+    assert announced[0] == pytest.approx(2.65, abs=0.011)
+    assert first < announced[0] - 0.005, (first, announced[0])
+
+
 def test_the_feet_turn_back_to_the_heading_after_a_push_that_yaws_them():
     """IHMC's outward push at 0.76 m g (24.8 N s over 0.1 s in the double support, 3.15 s)
     spins G1's feet 10-20 deg off the planner's heading. Each swing sole leaves the

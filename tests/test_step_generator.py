@@ -291,8 +291,9 @@ def test_predicted_step_time_and_location_match_the_step_taken():
     assert checked > 20
 
 
-def _walk_with_push(config, push_start, force, duration, until):
-    """Drive the generator on the exact LIPM with a constant push; returns its outputs."""
+def _walk_with_push(config, push_start, force, duration, until, swing_contact=None):
+    """Drive the generator on the exact LIPM with a constant push; returns its outputs.
+    ``swing_contact(t)``, if given, is reported in single support (None in double)."""
     initial = walking_start(config)
     generator = ReactiveStepGenerator(config)
     generator.reset(initial.stance, initial.swing)
@@ -300,7 +301,10 @@ def _walk_with_push(config, push_start, force, duration, until):
     dt, outputs, estimates = 0.001, [], []
     for k in range(int(until / dt)):
         t = k * dt
-        out = generator.update(MeasuredState(t, com, velocity), dt)
+        contact = None
+        if swing_contact is not None and outputs and not outputs[-1].double_support:
+            contact = swing_contact(t)
+        out = generator.update(MeasuredState(t, com, velocity, swing_contact=contact), dt)
         outputs.append(out)
         estimates.append(generator.push_estimate.copy())
         pushed = push_start - 1e-9 <= t < push_start + duration - 1e-9
@@ -435,6 +439,55 @@ def test_step_reaction_time_is_validated():
 
     with pytest.raises(ParameterError, match="step_reaction_time"):
         _reaction_config(-0.1)
+
+
+def test_a_timing_jump_comes_at_a_touchdown_before_its_time():
+    """A swing sole that lands 30 ms before its scheduled timing jump: the jump comes at
+    that touchdown, onto the announced foothold; a contact before the landing window
+    (``touchdown_window``, 0.1 s), without a lift-off seen first (a sole still on the
+    ground) or for a step at the nominal time brings nothing forward."""
+    config = _reaction_config(0.1, touchdown_window=0.1)
+    push = (2.7, np.array([0.0, 600.0]), 0.1, 3.2)
+    on_time, _ = _walk_with_push(config, *push)
+    index = next(k for k, o in enumerate(on_time) if o.time >= 2.7 and o.step is not None)
+    scheduled = on_time[index].step.time
+    assert on_time[index].step.timing_adjusted
+    landing = scheduled - 0.03
+    early, _ = _walk_with_push(
+        config, *push, swing_contact=lambda t: t < 2.7 or t >= landing - 1e-9
+    )
+    index = next(k for k, o in enumerate(early) if o.time >= 2.7 and o.step is not None)
+    step = early[index].step
+    assert step.time == pytest.approx(landing, abs=1.5e-3)
+    assert step.timing_adjusted and step.location_adjusted
+    np.testing.assert_allclose(step.position, early[index - 1].next_step.position, atol=1e-12)
+    # With a 0.2 s reaction time, a brief contact 0.15 s before the step (a scrape,
+    # before the landing window): the step keeps its time.
+    slow = _reaction_config(0.2, touchdown_window=0.1)
+    quiet, _ = _walk_with_push(slow, *push)
+    due = next(o.step.time for o in quiet if o.time >= 2.7 and o.step is not None)
+    scraped, _ = _walk_with_push(
+        slow, *push, swing_contact=lambda t: t < 2.7 or 0.0 <= due - 0.15 - t < 0.01 or t >= due
+    )
+    index = next(k for k, o in enumerate(scraped) if o.time >= 2.7 and o.step is not None)
+    assert scraped[index].step.time == pytest.approx(due, abs=1.5e-3)
+    # Touching from the swing's start on (never lifted): the step keeps its time.
+    dragged, _ = _walk_with_push(config, *push, swing_contact=lambda t: True)
+    index = next(k for k, o in enumerate(dragged) if o.time >= 2.7 and o.step is not None)
+    assert dragged[index].step.time == pytest.approx(scheduled, abs=1.5e-3)
+    # A timing jump at the nominal step's time (decided 0.1 s before it): it waits for
+    # the reference's own jump, touchdown or not.
+    config = _reaction_config(0.2, touchdown_window=0.1)
+    quiet, _ = _walk_with_push(config, 10.0, np.zeros(2), 0.1, 3.2)
+    nominal = [o.step.time for o in quiet if o.step is not None and o.time > 1.5][0]
+    push = (nominal - 0.1, np.array([0.0, 900.0]), 0.05, 3.2)
+    landing = nominal - 0.03
+    touching, _ = _walk_with_push(
+        config, *push, swing_contact=lambda t: t < nominal - 0.1 or t >= landing - 1e-9
+    )
+    index = next(k for k, o in enumerate(touching) if o.time >= push[0] and o.step is not None)
+    assert touching[index].step.location_adjusted
+    assert touching[index].step.time == pytest.approx(nominal, abs=2e-3)
 
 
 def test_a_due_jump_waits_for_the_swing_sole_to_touch_down():

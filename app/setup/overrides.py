@@ -74,6 +74,7 @@ DESCRIPTION_FIELDS = {
     "filter_time_constant": "float",
     "step_reaction_time": "float",
     "reanchor_time": "float",
+    "touchdown_window": "float",
     "dcm_inset": "float | None",
     "physics_time_step": "float",
     "solver_iterations": "int",
@@ -93,6 +94,7 @@ PYBULLET_ONLY_FIELDS = frozenset(
         "physics_time_step",
         "solver_iterations",
         "locked_joints",
+        "touchdown_window",
     }
 )
 

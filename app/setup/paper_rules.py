@@ -31,6 +31,7 @@ PAPER_RULES: tuple[Extension, ...] = (
     Extension("the QP's location for a timing jump below gamma_v", "qp_at_timing_jump", False),
     Extension("the announced foothold at a nominal jump", "announced_foothold", False),
     Extension("the next step previewed at the touchdown", "preview_at_touchdown", False),
+    Extension("a timing jump at an early touchdown", "touchdown_window", 0.0),
     Extension("the leg reach in the step QP", "com_reach", math.inf),
     Extension("the DCM row (27c')", "dcm_inset", None),
 )

@@ -52,6 +52,7 @@ def planner_config_for(
             filter_time_constant=description.filter_time_constant,
             step_reaction_time=description.step_reaction_time,
             reanchor_time=description.reanchor_time,
+            touchdown_window=description.touchdown_window,
             dcm_inset=description.dcm_inset,
             push_hold_time=0.0,  # the paper's D_T: no push estimate from the robot's CoM
         ),
