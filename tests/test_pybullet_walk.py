@@ -213,7 +213,7 @@ def test_a_sole_landing_before_its_timing_jump_is_stepped_on_at_once():
     touching = [False]
 
     def observe(out: PlannerOutput, backend: Any) -> None:
-        if out.time < push.time + 0.1 or len(steps) > 1:
+        if out.time < push.time + 0.1 or steps:
             return
         if out.step is not None:
             steps.append((out.time, touching[0]))
