@@ -22,12 +22,10 @@ under position control, kept since):
   has just moved (the planner decides an early step that long before touchdown).
 * ``reanchor_time`` 0.2 s: the planner moves its foothold to the measured stance
   sole over 0.2 s rather than in one tick.
-* ``touchdown_window`` 0.1 s: a timing jump comes at the swing sole's touchdown when
-  that is up to 0.1 s early (the landing rule sends the sole down over that time);
-  waiting for the planned time, a sole touching 30 ms early bounced off while the
-  stance foot rolled on its edge. Development grid 0.532 against 0.510, seed 1 the same
-  outcomes with 156 adjusted steps against 149 (docs/notes/2026-12-06-touchdown-jump.md);
-  Talos keeps 0 (its soles land 40-100 ms early; 96 against 98 recovered).
+* ``touchdown_window`` 0.1 s (the landing rule's window): a step brought forward comes at
+  a touchdown up to that early, before a sole that touched early can bounce off while
+  the stance foot rolls on its edge (docs/notes/2026-12-06-touchdown-jump.md; Talos,
+  whose soles land 40-100 ms early, keeps 0).
 * ``step_min``/``step_max`` y -+0.55 m (x [-0.25, 0.35] m): the outward step after a
   crossing step is what catches a push towards the stance side; 0.55 m is the legs'
   lateral reach, the widest stance with flat soles and the CoM midway at c_z
