@@ -21,14 +21,16 @@ as the IK sways the CoM over the feet the body's angular momentum follows the Co
 velocity with h_r 0.121 m along x, 0.119 m along y (``kinematics/pendulum.py``; the 0.115 m
 used was measured along y while the IK still moved the arms, within 1 cm of both). The
 whole-body stabilizer's defaults, chosen on G1, are used (its joint gains follow from
-each joint's effort limit) but one: the planner reads the velocity of the angular
+each joint's effort limit) but two: the planner reads the velocity of the angular
 momentum about the CoP (``momentum_velocity``): what its heavy swinging leg holds is
 counted as the CoM velocity it gives back (development pushes, seeds 1 and 3: 92 and 96
 of 100 recovered against 91 and 88, and 9 % fewer adjusted steps, 288 against 317;
-docs/notes/2026-12-05-momentum-about-the-cop.md). Talos lists no upper-body joints, so it has no
-flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders
-did no better on the development pushes, and worse taking back the legs' momentum;
-docs/notes/2026-12-03-talos-reach.md).
+docs/notes/2026-12-05-momentum-about-the-cop.md); and its net force is the LIPM's m g
+(``height_frequency`` 0): with G1's height loop its development grid fell to 0.635 of the
+bound from 0.660 (docs/notes/2026-12-06-height-loop.md). Talos lists no upper-body
+joints, so it has no flywheel and the whole hdot goes to the CoP (a flywheel of the
+torso and the shoulders did no better on the development pushes, and worse taking back
+the legs' momentum; docs/notes/2026-12-03-talos-reach.md).
 """
 
 from __future__ import annotations
@@ -101,5 +103,5 @@ TALOS = RobotDescription(
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
-    backend_options={"momentum_velocity": True},
+    backend_options={"momentum_velocity": True, "height_frequency": 0.0},
 )

@@ -9,6 +9,7 @@ import pytest
 from app.stabilizer.centroidal import (
     centre_of_pressure,
     contact_force,
+    height_acceleration,
     momentum_velocity,
     pivot,
     sway_rate,
@@ -96,6 +97,36 @@ def test_the_net_force_is_the_lipms():
         force = contact_force(MODEL, com, r)
         np.testing.assert_allclose(force[:2] / MODEL.mass, MODEL.omega**2 * (com - r))
         assert force[2] == pytest.approx(MODEL.mass * GRAVITY)
+
+
+def test_with_a_vertical_acceleration_the_force_line_still_passes_through_the_com():
+    """f_z = m (g + zdd), never pulling, and f_xy = f_z (c - r) / Z: the pivot stays where
+    the force line meets the ground (no moment about the CoM), and applied at the ZMP the
+    force turns the body at hdot f_z / (m g)."""
+    for zdd in (-3.0, -0.5, 0.5, 4.0):
+        for com, zmp, rate in cases(20):
+            r = pivot(zmp, rate, MODEL.mass)
+            force = contact_force(MODEL, com, r, zdd)
+            assert force[2] == pytest.approx(MODEL.mass * (GRAVITY + zdd))
+            np.testing.assert_allclose(force[:2] / force[2], (com - r) / MODEL.com_height)
+            np.testing.assert_allclose(moment_about_com(r, com, force), 0.0, atol=1e-9)
+            turning = rate * force[2] / (MODEL.mass * GRAVITY)
+            np.testing.assert_allclose(moment_about_com(zmp, com, force), turning, atol=1e-9)
+    np.testing.assert_array_equal(contact_force(MODEL, np.ones(2), np.zeros(2), -2 * GRAVITY), 0.0)
+
+
+def test_the_height_loop_brings_a_bounced_com_back_without_overshoot():
+    """zdd = omega_z^2 (z* - z) - 2 omega_z zdot is critically damped: a CoM launched
+    upward at 0.4 m/s (a touchdown's bounce) returns to its height without crossing it,
+    and within 1 mm after 7 / omega_z."""
+    frequency, dt = 10.0, 1e-4
+    error, velocity, lowest = 0.0, 0.4, 0.0  # z - z* [m], zdot [m/s]
+    for _ in range(round(0.7 / dt)):
+        velocity += height_acceleration(frequency, -error, velocity) * dt
+        error += velocity * dt
+        lowest = min(lowest, error)
+    assert lowest > -1e-4 and abs(error) < 1e-3
+    assert height_acceleration(frequency, 0.01, 0.0) == pytest.approx(1.0)  # omega_z^2 per m
 
 
 def test_in_single_support_the_cop_is_clipped_to_the_stance_sole():

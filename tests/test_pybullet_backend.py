@@ -336,11 +336,12 @@ def test_the_physics_log_records_every_step_consistently(pushed_runs, tmp_path):
     assert column["push_fx"].sum() * step == pytest.approx(6.0, rel=1e-6)
     assert column["push_fy"].sum() * step == pytest.approx(3.0, rel=1e-6)
     assert np.all(column["left_sole_z"] > -0.005)
-    # The controller's plan next to the ground's: the distributed forces carry the weight;
+    # The controller's plan next to the ground's: the distributed forces carry the weight
+    # (and the height loop's correction for a CoM within a millimetre of its target);
     # before the push each foot's measured force follows its planned one, and while the
     # push moves the planned CoP by centimetres, the net CoP follows it.
     planned = column["left_fz_planned"] + column["right_fz_planned"]
-    assert planned[quiet].mean() == pytest.approx(mass * GRAVITY, rel=1e-3)
+    assert planned[quiet].mean() == pytest.approx(mass * GRAVITY, rel=5e-3)
     for foot in ("left", "right"):
         gap = np.abs(column[f"{foot}_fz"] - column[f"{foot}_fz_planned"])[quiet]
         assert gap.mean() < 0.03 * mass * GRAVITY, foot

@@ -6,6 +6,13 @@ H = [[0, -1], [1, 0]] of (1), and the CoM accelerates as
 
     m cdd = m omega^2 (c - r)       (horizontal),      vertical force m g.
 
+The robot's CoM height is not the LIPM's by construction: a touchdown or a foot rolling
+on its edge moves it, and the legs then push more or less than m g. The net force holds
+the height with a critically damped loop, f_z = m (g + zdd) (the CoM feedback of Hyon,
+Hale and Cheng, "Full-body compliant human-humanoid interaction", IEEE T-RO 2007), so
+the feet's moments are planned for the force they will carry; its horizontal part keeps
+the line from the pivot through the CoM (a pendulum's, f_xy = f_z (c - r) / Z).
+
 On the robot the ground's centre of pressure and the body's own angular momentum
 rate Ldot together make the pivot: r = cop - H Ldot / (m g). So the CoP that realises
 the planner's pivot while the body moves with Ldot is
@@ -76,12 +83,26 @@ def centre_of_pressure(
     return np.minimum(np.maximum(cop, low), high)
 
 
+def height_acceleration(frequency: float, height_error: float, vertical_velocity: float) -> float:
+    """Vertical CoM acceleration [m/s^2] of a critically damped height loop,
+    omega_z^2 (z* - z) - 2 omega_z zdot, at ``frequency`` omega_z [rad/s] for the error
+    z* - z [m] and the CoM's vertical velocity [m/s]."""
+    return frequency**2 * height_error - 2.0 * frequency * vertical_velocity
+
+
 def contact_force(
-    model: LipmModel, com: NDArray[np.float64], pivot_point: NDArray[np.float64]
+    model: LipmModel,
+    com: NDArray[np.float64],
+    pivot_point: NDArray[np.float64],
+    vertical_acceleration: float = 0.0,
 ) -> NDArray[np.float64]:
-    """Net ground force [N], shape (3,): the LIPM's m omega^2 (c - r) and m g."""
-    horizontal = model.mass * model.omega**2 * (np.asarray(com, float) - pivot_point)
-    return np.array([horizontal[0], horizontal[1], model.mass * model.gravity])
+    """Net ground force [N], shape (3,): m (g + zdd) upward (never pulling), and along
+    the line from the pivot through the CoM, so it adds no moment about the CoM:
+    f_xy = f_z (c - r) / Z, the LIPM's m omega^2 (c - r) at zdd = 0."""
+    normal = max(model.mass * (model.gravity + vertical_acceleration), 0.0)
+    scale = normal / (model.mass * model.gravity)
+    horizontal = scale * model.mass * model.omega**2 * (np.asarray(com, float) - pivot_point)
+    return np.array([horizontal[0], horizontal[1], normal])
 
 
 def sway_rate(force: NDArray[np.float64], rotational_height: float) -> NDArray[np.float64]:

@@ -27,6 +27,10 @@ class StabilizerConfig:
         flywheel_cancel: Share of the legs' high-passed angular momentum the upper
             body takes back [-] (a leg swinging outwards otherwise pulls the pivot
             off the stance sole's edge).
+        height_frequency: omega_z, natural frequency of the CoM height loop in the net
+            force, critically damped [rad/s] (0: the LIPM's m g): the feet's moments are
+            planned for the force the legs will push with after a touchdown's bounce
+            (docs/notes/2026-12-06-height-loop.md).
         momentum_velocity: The planner reads the velocity of the angular momentum about
             the CoP, u (:func:`app.stabilizer.centroidal.momentum_velocity`), instead of
             the CoM velocity: what a swinging leg holds counts as the CoM velocity it
@@ -41,6 +45,7 @@ class StabilizerConfig:
     flywheel_momentum: float = 2.0
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.75
+    height_frequency: float = 10.0
     momentum_velocity: bool = False
 
     def __post_init__(self) -> None:
@@ -63,6 +68,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "flywheel_momentum": (0.0, 10.0),
     "flywheel_return_time": (0.05, 10.0),
     "flywheel_cancel": (0.0, 1.0),
+    "height_frequency": (0.0, 50.0),
 }
 
 OPTION_NAMES = tuple(field.name for field in fields(StabilizerConfig))

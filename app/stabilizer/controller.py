@@ -1,11 +1,12 @@
 """The whole-body controller: one control tick from the measurement to the joint command.
 
-    measure -> (plan: the RSG, outside) -> stabilize -> swing foot -> IK -> actuate
+    measure -> (plan: the RSG, outside) -> swing foot -> stabilize -> IK -> actuate
 
 * measure: the state estimate (:mod:`.estimator`) from the measurement record;
-* stabilize: the pivot the planner commands, the CoP and net force that realise it
-  (:mod:`.centroidal`), shared among the feet on the ground (:mod:`.wrench_distribution`);
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
+* stabilize: the pivot the planner commands, the CoP and net force that realise it and
+  hold the CoM at the height the IK will be asked for (:mod:`.centroidal`), shared among
+  the feet on the ground (:mod:`.wrench_distribution`);
 * IK: placo's whole-body IK, with the upper body as a flywheel for hdot
   (:mod:`kinematics.upper_body`);
 * actuate: per joint a target, stiffness, damping and the feed-forward torque from
@@ -168,9 +169,17 @@ class WholeBodyController:
         state = self._estimate(measurement, command)  # measure
         if stance != self._stance:  # the planner stepped: the old stance foot lifts off
             self._start_swing(stance, swing)
-        # stabilize
+        # swing foot
+        soles = self._sole_targets(command, stance, swing)
+        self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
+        # stabilize: the net force holds the IK's CoM height
         pivot = centroidal.pivot(command.zmp, command.angular_momentum_rate, self.mass)
-        force = centroidal.contact_force(self.lipm, state.com[:2], pivot)
+        lift = centroidal.height_acceleration(
+            self.config.height_frequency,
+            self.ik.com_z_target(soles["left"], soles["right"]) - state.com[2],
+            state.com_velocity[2],
+        )
+        force = centroidal.contact_force(self.lipm, state.com[:2], pivot, lift)
         sway = centroidal.sway_rate(force, self.description.rotational_height)
         self.planned_cop = centroidal.centre_of_pressure(
             pivot,
@@ -183,9 +192,6 @@ class WholeBodyController:
         com_target, _ = integrate_lipm(
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
-        # swing foot
-        soles = self._sole_targets(command, stance, swing)
-        self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
         # IK
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
