@@ -26,11 +26,11 @@ momentum about the CoP (``momentum_velocity``): what its heavy swinging leg hold
 counted as the CoM velocity it gives back (development pushes, seeds 1 and 3: 92 and 96
 of 100 recovered against 91 and 88, and 9 % fewer adjusted steps, 288 against 317;
 docs/notes/2026-12-05-momentum-about-the-cop.md); and its net force is the LIPM's m g
-(``height_frequency`` 0): with G1's height loop its development grid fell to 0.635 of the
-bound from 0.660 (docs/notes/2026-12-06-height-loop.md). Talos lists no upper-body
-joints, so it has no flywheel and the whole hdot goes to the CoP (a flywheel of the
-torso and the shoulders did no better on the development pushes, and worse taking back
-the legs' momentum; docs/notes/2026-12-03-talos-reach.md).
+(``height_frequency`` 0): G1's CoM height loop lowered its development grid
+(docs/notes/2026-12-06-height-loop.md). Talos lists no upper-body joints, so it has no
+flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders did
+no better on the development pushes, and worse taking back the legs' momentum;
+docs/notes/2026-12-03-talos-reach.md).
 """
 
 from __future__ import annotations
