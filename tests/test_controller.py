@@ -100,6 +100,21 @@ def test_a_tick_on_a_hand_made_measurement_holds_the_robot_up():
     assert order.torque[knees[0]] == pytest.approx(order.torque[knees[1]], rel=0.05)
 
 
+def test_the_swing_sole_reaches_a_catching_foothold_moved_late_by_its_step_time():
+    """A catching step: 0.3 s before the planned touchdown the foothold moves 0.6 m further
+    ahead. The controller's swing trajectory is over it and on the ground at the step time
+    (at a 2 m/s speed bound it was still 11 cm short and 6 cm up)."""
+    controller, _ = standing()
+    swing, landing, dt = controller.swing, 0.6, 0.01
+    swing.start(np.array([0.0, -0.1]))
+    for k in range(1, round(landing / dt) + 1):
+        time = k * dt
+        target = np.array([0.2, -0.1]) if time < landing - 0.3 else np.array([0.8, -0.1])
+        position = swing.update(time, target, dt, landing_time=landing)
+    assert np.linalg.norm(position[:2] - target) < 0.005
+    assert position[2] == pytest.approx(0.0, abs=0.003)
+
+
 def test_with_leg_odometry_the_tick_ignores_the_simulators_truth():
     """In ``odometry`` mode the base comes from the stance foot, the encoders and the
     IMU: a measurement whose truth fields (base position and velocity) are wrong
