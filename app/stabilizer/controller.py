@@ -47,7 +47,7 @@ ACCELERATION_LIMIT = 50.0  # [rad/s^2] bound on the feed-forward joint accelerat
 MOMENTUM_FILTER = 0.05  # [s] low-pass of the IK motion's angular momentum rate
 SWING_ACCELERATION = 20.0  # [m/s^2] bound on the swing sole's re-planned approach
 SWING_SPEED = 3.0  # [m/s] bound on the swing sole's speed: a catching step's foothold moves
-# up to 0.6 m with 0.2-0.3 s left, which at 2 m/s lands late (docs/notes/2026-12-06-height-loop.md)
+# up to 0.6 m with 0.2-0.3 s left, which at 2 m/s lands late (docs/notes/2026-12-06-swing-speed.md)
 SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
 
 
