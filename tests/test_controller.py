@@ -115,6 +115,15 @@ def test_the_swing_sole_reaches_a_catching_foothold_moved_late_by_its_step_time(
     assert position[2] == pytest.approx(0.0, abs=0.003)
 
 
+def test_the_feet_wrenches_are_bounded_by_the_ankles_effort_limits():
+    """The wrench distribution is given each robot's ankle roll and pitch effort limits
+    from its URDF (G1 35 and 35 N m, Talos 100 and 160 N m)."""
+    controller, _ = standing()
+    assert controller.limits.ankle_torque == (35.0, 35.0)
+    talos = WholeBodyController(get_robot("talos"), SwingTiming(), 0.01, StabilizerConfig())
+    assert talos.limits.ankle_torque == (100.0, 160.0)
+
+
 def test_with_leg_odometry_the_tick_ignores_the_simulators_truth():
     """In ``odometry`` mode the base comes from the stance foot, the encoders and the
     IMU: a measurement whose truth fields (base position and velocity) are wrong

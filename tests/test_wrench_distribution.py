@@ -4,6 +4,8 @@ can be, the nearest point of the support when they cannot."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
@@ -250,3 +252,35 @@ def test_bounds_that_cannot_hold_together_are_an_error_with_its_data():
         distribute_wrench(contacts, force, cop, LIMITS)
     assert error.value.feet == 2
     np.testing.assert_array_equal(error.value.force, force)
+
+
+def ankle_torque(contact, wrench):
+    """The ankle's roll and pitch torques [N m] of ``wrench`` (f, m) at the sole point,
+    in the sole's axes: the moment about the ankle, ``ankle_height`` above it."""
+    turn = rotation(contact.yaw)
+    force, moment = turn.T @ wrench[:3], turn.T @ wrench[3:]
+    return (moment - np.cross([0.0, 0.0, contact.ankle_height], force))[:2]
+
+
+@pytest.mark.parametrize("count", [1, 2])
+def test_no_ankle_is_given_more_torque_than_its_effort_limit(count):
+    """G1's ankles push with 35 N m, which under its weight holds the CoP about 10 cm from
+    the ankle; the sole reaches 12 cm. Asked for the CoP at a toe, every foot's ankle
+    torques stay within the limit, the force is the one asked, and in single support the
+    CoP is as far forward as the ankle allows (without the limit the toe needs ~40 N m)."""
+    limited = dataclasses.replace(LIMITS, ankle_torque=(35.0, 35.0))
+    rng = np.random.default_rng(5)
+    for case in range(50):
+        contacts = random_feet(rng, count)
+        front = contacts[0]
+        toe = front.sole_point[:2] + rotation(front.yaw)[:2, :2] @ np.array([SOLE.x_max, 0.0])
+        force = np.array([*rng.uniform(-0.1, 0.1, 2) * WEIGHT, WEIGHT * rng.uniform(1.0, 1.3)])
+        wrenches = distribute_wrench(contacts, force, toe, limited)
+        for contact, wrench in zip(contacts, wrenches, strict=True):
+            assert np.all(np.abs(ankle_torque(contact, wrench)) <= 35.0 + 1e-3), f"{case=}"
+            assert cone_violation(contact, wrench) < CONE_TOLERANCE * WEIGHT, f"{case=}"
+        np.testing.assert_allclose(np.sum(wrenches, axis=0)[:3], force, atol=1e-3 * WEIGHT)
+        if count == 1:
+            (free,) = distribute_wrench(contacts, force, toe, LIMITS)
+            assert abs(ankle_torque(front, free)[1]) > 36.0, f"{case=}"
+            assert abs(ankle_torque(front, wrenches[0])[1]) == pytest.approx(35.0, abs=1e-6)

@@ -10,6 +10,13 @@ force and CoP are soft, with the force weighted far above the CoP, so a CoP outs
 the support ends on its nearest edge at the desired force. A small cost on the ankle
 torques makes the split between two feet unique (each CoP as close to its ankle as
 the balance allows).
+
+The cone also bounds each ankle's roll and pitch torques by the joints' effort limits
+(the torque limits of a whole-body QP, e.g. Koolen et al., "Design of a momentum-based
+control framework and application to the humanoid robot Atlas", IJHR 2016): a sole's
+CoP is only as far from its ankle as the ankle can push, |x| <= tau_max / f_z. The
+moments are taken about the ankle in the sole's axes, those of a flat foot's ankle
+joints.
 """
 
 from __future__ import annotations
@@ -62,12 +69,15 @@ class ContactLimits:
         friction: Coulomb friction coefficient [-] (pyramid, inner approximation).
         torsion_arm: Torsion bound per newton of normal force [m].
         min_force: Smallest normal force of a foot in contact [N].
+        ankle_torque: Bounds on the ankle's roll and pitch torques [N m] (the joints'
+            effort limits; inf: none).
     """
 
     sole: SoleRectangle
     friction: float = 0.7
     torsion_arm: float = 0.01
     min_force: float = 0.0
+    ankle_torque: tuple[float, float] = (np.inf, np.inf)
 
 
 class WrenchDistributionError(RsgError):
@@ -121,8 +131,19 @@ def _cone(limits: ContactLimits, contact: FootContact) -> tuple[NDArray, NDArray
         ([0.0, 0.0, -limits.torsion_arm], [0.0, 0.0, 1.0]),
         ([0.0, 0.0, -limits.torsion_arm], [0.0, 0.0, -1.0]),
     ]
+    h_list = [0.0] * len(rows_local)
+    # ankle torque tau' = m' - h e_z x f' = (m'_x + h f'_y, m'_y - h f'_x) within its bounds
+    arm = contact.ankle_height
+    roll, pitch = limits.ankle_torque
+    for sign in (1.0, -1.0):
+        if np.isfinite(roll):
+            rows_local.append(([0.0, sign * arm, 0.0], [sign, 0.0, 0.0]))
+            h_list.append(roll)
+        if np.isfinite(pitch):
+            rows_local.append(([-sign * arm, 0.0, 0.0], [0.0, sign, 0.0]))
+            h_list.append(pitch)
     G = np.array([np.concatenate([f @ rotation.T, m @ rotation.T]) for f, m in rows_local])
-    h = np.zeros(len(rows_local))
+    h = np.array(h_list)
     bounds = [(np.array([0, 0, -1.0, 0, 0, 0]), -max(limits.min_force, contact.min_force))]
     if np.isfinite(contact.max_force):
         bounds.append((np.array([0, 0, 1.0, 0, 0, 0]), contact.max_force))
@@ -191,7 +212,8 @@ def _single_support(
     limits: ContactLimits,
 ) -> NDArray[np.float64]:
     """The QP's solution for one foot in closed form: the force within the friction
-    pyramid, the CoP clipped to the sole, no torsion."""
+    pyramid, the CoP clipped to the sole and to where the ankle's torques reach, no
+    torsion."""
     rotation = _yaw_matrix(contact.yaw)
     normal = float(np.clip(force[2], max(limits.min_force, contact.min_force), contact.max_force))
     local_force = rotation.T @ force
@@ -199,8 +221,16 @@ def _single_support(
     local_force = np.array([*np.clip(local_force[:2], -bound, bound), normal])
     offset = rotation.T @ np.array([cop[0], cop[1], 0.0]) - rotation.T @ contact.sole_point
     sole = limits.sole
-    x = float(np.clip(offset[0], sole.x_min, sole.x_max))
-    y = float(np.clip(offset[1], -sole.half_width, sole.half_width))
+    x_low, x_high, y_low, y_high = sole.x_min, sole.x_max, -sole.half_width, sole.half_width
+    if normal > 0.0:  # tau'_y = -x f_z - h f'_x, tau'_x = y f_z + h f'_y within the bounds
+        roll, pitch = limits.ankle_torque
+        arm = contact.ankle_height
+        x_low = max(x_low, min((-pitch - arm * local_force[0]) / normal, x_high))
+        x_high = min(x_high, max((pitch - arm * local_force[0]) / normal, x_low))
+        y_low = max(y_low, min((-roll - arm * local_force[1]) / normal, y_high))
+        y_high = min(y_high, max((roll - arm * local_force[1]) / normal, y_low))
+    x = float(np.clip(offset[0], x_low, x_high))
+    y = float(np.clip(offset[1], y_low, y_high))
     local_moment = np.array([y * normal, -x * normal, 0.0])
     return np.concatenate([rotation @ local_force, rotation @ local_moment])
 
