@@ -197,6 +197,25 @@ def test_a_feasible_case_its_solver_once_called_infeasible_is_solved():
     assert np.linalg.norm(realised - nearest_point_of_support(contacts, cop)) < COP_TOLERANCE
 
 
+def test_a_case_proxqps_initial_guess_called_infeasible_with_ankle_limits_is_solved():
+    """Two crossed feet of a falling G1 and a CoP 0.7 m away: feasible (the rows hold at
+    zero wrench on one foot), but proxqp from its default initial guess declared it
+    primal infeasible once the ankle-torque rows were in the cone."""
+    limits = dataclasses.replace(LIMITS, ankle_torque=(35.0, 35.0))
+    contacts = [
+        FootContact(np.array([0.5529622457083501, -0.4649455043525553, 0.0]), 0.5828, 0.035),
+        FootContact(np.array([0.5960208338052637, -0.5227239554504023, 0.0]), 0.1904, 0.035),
+    ]
+    force = np.array([11.470704274717866, 4.634481819489441, 328.3572132777546])
+    cop = np.array([0.42409512634901336, 0.2530349862429677])
+    wrenches = distribute_wrench(contacts, force, cop, limits)
+    for contact, wrench in zip(contacts, wrenches, strict=True):
+        assert cone_violation(contact, wrench, limits) < CONE_TOLERANCE * force[2]
+        assert np.all(np.abs(ankle_torque(contact, wrench)) <= 35.0 + 1e-3)
+    # the CoP's cost, 0.7 m off, takes 0.5 % off the force (as without the ankle rows)
+    np.testing.assert_allclose(np.sum(wrenches, axis=0)[:3], force, atol=0.01 * force[2])
+
+
 def test_in_single_support_a_cop_outside_the_sole_is_clipped_onto_it():
     """The closed form: the CoP the nearest point of the (yawed) sole, the force kept
     where the friction pyramid allows and clipped to it where not, no torsion."""

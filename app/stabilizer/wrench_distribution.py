@@ -37,8 +37,10 @@ from robots.description import SoleRectangle
 FORCE_WEIGHT = 1.0  # on the net force error [-]
 MOMENT_WEIGHT = 1e-2  # on the horizontal moment about the desired CoP [1/m^2]
 ANKLE_WEIGHT = 1e-4  # on each foot's ankle torque [1/m^2] (breaks ties)
-# (regularisation on every wrench coordinate, proxqp's eps_abs): the second if the first stalls
-ATTEMPTS = ((1e-8, 1e-8), (1e-6, 1e-7))
+# (regularisation on every wrench coordinate, proxqp's eps_abs, cold start): the second if the
+# first stalls; the third from zero, as proxqp's default initial guess once led it to call a
+# feasible case with the ankle-torque rows infeasible
+ATTEMPTS = ((1e-8, 1e-8, False), (1e-6, 1e-7, False), (1e-8, 1e-8, True))
 
 
 @dataclass(frozen=True)
@@ -196,8 +198,10 @@ def distribute_wrench(
     for index, (G_foot, h_foot) in enumerate(cones):
         G[row : row + len(h_foot), 6 * index : 6 * index + 6] = G_foot
         row += len(h_foot)
-    for regularisation, eps_abs in ATTEMPTS:
-        solution = solve_polished(P + regularisation * np.eye(size), q, G, h, eps_abs=eps_abs)
+    for regularisation, eps_abs, cold_start in ATTEMPTS:
+        solution = solve_polished(
+            P + regularisation * np.eye(size), q, G, h, eps_abs=eps_abs, cold_start=cold_start
+        )
         if solution is not None:
             break
     if solution is None:
