@@ -16,7 +16,6 @@ from __future__ import annotations
 import numpy as np
 import qpsolvers
 from numpy.typing import NDArray
-from proxsuite import proxqp
 
 DUAL_TOLERANCE = 1e-9  # a multiplier above this marks its row active; below -this, not
 ACTIVE_TOLERANCE = 1e-7  # a row this close to its bound (relative) starts active
@@ -32,21 +31,17 @@ def solve_polished(
     lb: NDArray[np.float64] | None = None,
     ub: NDArray[np.float64] | None = None,
     eps_abs: float = 1e-9,
-    cold_start: bool = False,
 ) -> NDArray[np.float64] | None:
     """The QP's minimiser, or None if proxqp finds none.
 
     Falls back to proxqp's own answer when the polished point is not a KKT point
     (a degenerate active set); that answer is within ``eps_abs`` of the optimum.
-    ``cold_start``: proxqp starts from zero instead of its default initial guess (the
-    minimiser without the inequalities).
 
     Raises:
         qpsolvers.SolverError, ValueError: from qpsolvers, on malformed input.
     """
     problem = qpsolvers.Problem(P, q, G, h, lb=lb, ub=ub)
-    settings = {"initial_guess": proxqp.InitialGuess.NO_INITIAL_GUESS} if cold_start else {}
-    solution = qpsolvers.solve_problem(problem, "proxqp", eps_abs=eps_abs, eps_rel=0.0, **settings)
+    solution = qpsolvers.solve_problem(problem, "proxqp", eps_abs=eps_abs, eps_rel=0.0)
     if not solution.found or solution.x is None:
         return None
     rows, bounds, duals = _inequalities(len(q), G, h, lb, ub, solution)

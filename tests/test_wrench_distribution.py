@@ -197,10 +197,9 @@ def test_a_feasible_case_its_solver_once_called_infeasible_is_solved():
     assert np.linalg.norm(realised - nearest_point_of_support(contacts, cop)) < COP_TOLERANCE
 
 
-def test_a_case_proxqps_initial_guess_called_infeasible_with_ankle_limits_is_solved():
-    """Two crossed feet of a falling G1 and a CoP 0.7 m away: feasible (the rows hold at
-    zero wrench on one foot), but proxqp from its default initial guess declared it
-    primal infeasible once the ankle-torque rows were in the cone."""
+def test_crossed_feet_and_a_cop_far_away_get_wrenches_within_the_ankles_limits():
+    """Two crossed feet of a falling G1 and a CoP 0.7 m away (with the ankle limits as rows
+    of the QP, proxqp declared this case infeasible)."""
     limits = dataclasses.replace(LIMITS, ankle_torque=(35.0, 35.0))
     contacts = [
         FootContact(np.array([0.5529622457083501, -0.4649455043525553, 0.0]), 0.5828, 0.035),

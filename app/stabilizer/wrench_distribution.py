@@ -11,12 +11,13 @@ the support ends on its nearest edge at the desired force. A small cost on the a
 torques makes the split between two feet unique (each CoP as close to its ankle as
 the balance allows).
 
-The cone also bounds each ankle's roll and pitch torques by the joints' effort limits
-(the torque limits of a whole-body QP, e.g. Koolen et al., "Design of a momentum-based
-control framework and application to the humanoid robot Atlas", IJHR 2016): a sole's
-CoP is only as far from its ankle as the ankle can push, |x| <= tau_max / f_z. The
+Each foot's wrench then has its ankle's roll and pitch torques within the joints'
+effort limits (the torque limits of a whole-body QP, e.g. Koolen et al., "Design of a
+momentum-based control framework and application to the humanoid robot Atlas", IJHR
+2016): a sole's CoP is only as far from its ankle as the ankle can push, about
+tau_max / f_z, and a CoP beyond is moved towards the ankle with the force kept. The
 moments are taken about the ankle in the sole's axes, those of a flat foot's ankle
-joints.
+joints. (As rows of the QP the limits led proxqp to declare feasible cases infeasible.)
 """
 
 from __future__ import annotations
@@ -37,10 +38,8 @@ from robots.description import SoleRectangle
 FORCE_WEIGHT = 1.0  # on the net force error [-]
 MOMENT_WEIGHT = 1e-2  # on the horizontal moment about the desired CoP [1/m^2]
 ANKLE_WEIGHT = 1e-4  # on each foot's ankle torque [1/m^2] (breaks ties)
-# (regularisation on every wrench coordinate, proxqp's eps_abs, cold start): the second if the
-# first stalls; the third from zero, as proxqp's default initial guess once led it to call a
-# feasible case with the ankle-torque rows infeasible
-ATTEMPTS = ((1e-8, 1e-8, False), (1e-6, 1e-7, False), (1e-8, 1e-8, True))
+# (regularisation on every wrench coordinate, proxqp's eps_abs): the second if the first stalls
+ATTEMPTS = ((1e-8, 1e-8), (1e-6, 1e-7))
 
 
 @dataclass(frozen=True)
@@ -133,19 +132,8 @@ def _cone(limits: ContactLimits, contact: FootContact) -> tuple[NDArray, NDArray
         ([0.0, 0.0, -limits.torsion_arm], [0.0, 0.0, 1.0]),
         ([0.0, 0.0, -limits.torsion_arm], [0.0, 0.0, -1.0]),
     ]
-    h_list = [0.0] * len(rows_local)
-    # ankle torque tau' = m' - h e_z x f' = (m'_x + h f'_y, m'_y - h f'_x) within its bounds
-    arm = contact.ankle_height
-    roll, pitch = limits.ankle_torque
-    for sign in (1.0, -1.0):
-        if np.isfinite(roll):
-            rows_local.append(([0.0, sign * arm, 0.0], [sign, 0.0, 0.0]))
-            h_list.append(roll)
-        if np.isfinite(pitch):
-            rows_local.append(([-sign * arm, 0.0, 0.0], [0.0, sign, 0.0]))
-            h_list.append(pitch)
     G = np.array([np.concatenate([f @ rotation.T, m @ rotation.T]) for f, m in rows_local])
-    h = np.array(h_list)
+    h = np.zeros(len(rows_local))
     bounds = [(np.array([0, 0, -1.0, 0, 0, 0]), -max(limits.min_force, contact.min_force))]
     if np.isfinite(contact.max_force):
         bounds.append((np.array([0, 0, 1.0, 0, 0, 0]), contact.max_force))
@@ -198,15 +186,16 @@ def distribute_wrench(
     for index, (G_foot, h_foot) in enumerate(cones):
         G[row : row + len(h_foot), 6 * index : 6 * index + 6] = G_foot
         row += len(h_foot)
-    for regularisation, eps_abs, cold_start in ATTEMPTS:
-        solution = solve_polished(
-            P + regularisation * np.eye(size), q, G, h, eps_abs=eps_abs, cold_start=cold_start
-        )
+    for regularisation, eps_abs in ATTEMPTS:
+        solution = solve_polished(P + regularisation * np.eye(size), q, G, h, eps_abs=eps_abs)
         if solution is not None:
             break
     if solution is None:
         raise WrenchDistributionError(count, np.asarray(force, float), np.asarray(cop, float))
-    return [scale * solution[6 * i : 6 * i + 6] for i in range(count)]
+    return [
+        _within_ankle_reach(contact, scale * solution[6 * i : 6 * i + 6], limits)
+        for i, contact in enumerate(contacts)
+    ]
 
 
 def _single_support(
@@ -216,8 +205,7 @@ def _single_support(
     limits: ContactLimits,
 ) -> NDArray[np.float64]:
     """The QP's solution for one foot in closed form: the force within the friction
-    pyramid, the CoP clipped to the sole and to where the ankle's torques reach, no
-    torsion."""
+    pyramid, the CoP clipped to the sole (then to the ankle's reach), no torsion."""
     rotation = _yaw_matrix(contact.yaw)
     normal = float(np.clip(force[2], max(limits.min_force, contact.min_force), contact.max_force))
     local_force = rotation.T @ force
@@ -225,18 +213,31 @@ def _single_support(
     local_force = np.array([*np.clip(local_force[:2], -bound, bound), normal])
     offset = rotation.T @ np.array([cop[0], cop[1], 0.0]) - rotation.T @ contact.sole_point
     sole = limits.sole
-    x_low, x_high, y_low, y_high = sole.x_min, sole.x_max, -sole.half_width, sole.half_width
-    if normal > 0.0:  # tau'_y = -x f_z - h f'_x, tau'_x = y f_z + h f'_y within the bounds
-        roll, pitch = limits.ankle_torque
-        arm = contact.ankle_height
-        x_low = max(x_low, min((-pitch - arm * local_force[0]) / normal, x_high))
-        x_high = min(x_high, max((pitch - arm * local_force[0]) / normal, x_low))
-        y_low = max(y_low, min((-roll - arm * local_force[1]) / normal, y_high))
-        y_high = min(y_high, max((roll - arm * local_force[1]) / normal, y_low))
-    x = float(np.clip(offset[0], x_low, x_high))
-    y = float(np.clip(offset[1], y_low, y_high))
+    x = float(np.clip(offset[0], sole.x_min, sole.x_max))
+    y = float(np.clip(offset[1], -sole.half_width, sole.half_width))
     local_moment = np.array([y * normal, -x * normal, 0.0])
-    return np.concatenate([rotation @ local_force, rotation @ local_moment])
+    wrench = np.concatenate([rotation @ local_force, rotation @ local_moment])
+    return _within_ankle_reach(contact, wrench, limits)
+
+
+def _within_ankle_reach(
+    contact: FootContact, wrench: NDArray[np.float64], limits: ContactLimits
+) -> NDArray[np.float64]:
+    """``wrench`` with its CoP moved towards the ankle, its force kept, until the ankle's
+    roll and pitch torques are within ``limits.ankle_torque``."""
+    rotation = _yaw_matrix(contact.yaw)
+    force, moment = rotation.T @ wrench[:3], rotation.T @ wrench[3:]
+    if not force[2] > 0.0:
+        return wrench
+    roll, pitch = limits.ankle_torque
+    arm = contact.ankle_height
+    # tau' = m' - h e_z x f' = (m'_x + h f'_y, m'_y - h f'_x); the CoP is (-m'_y, m'_x) / f'_z
+    x = float(np.clip(-moment[1], -pitch - arm * force[0], pitch - arm * force[0]))
+    y = float(np.clip(moment[0], -roll - arm * force[1], roll - arm * force[1]))
+    if x == -moment[1] and y == moment[0]:
+        return wrench
+    local_moment = np.array([y, -x, moment[2]])
+    return np.concatenate([wrench[:3], rotation @ local_moment])
 
 
 def center_of_pressure(
