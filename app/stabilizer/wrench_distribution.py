@@ -232,11 +232,11 @@ def _within_ankle_reach(
     roll, pitch = limits.ankle_torque
     arm = contact.ankle_height
     # tau' = m' - h e_z x f' = (m'_x + h f'_y, m'_y - h f'_x); the CoP is (-m'_y, m'_x) / f'_z
-    x = float(np.clip(-moment[1], -pitch - arm * force[0], pitch - arm * force[0]))
-    y = float(np.clip(moment[0], -roll - arm * force[1], roll - arm * force[1]))
-    if x == -moment[1] and y == moment[0]:
+    x_force = float(np.clip(-moment[1], -pitch - arm * force[0], pitch - arm * force[0]))
+    y_force = float(np.clip(moment[0], -roll - arm * force[1], roll - arm * force[1]))
+    if x_force == -moment[1] and y_force == moment[0]:  # (the CoP's x and y times f'_z)
         return wrench
-    local_moment = np.array([y, -x, moment[2]])
+    local_moment = np.array([y_force, -x_force, moment[2]])
     return np.concatenate([wrench[:3], rotation @ local_moment])
 
 
