@@ -237,11 +237,11 @@ def test_the_feet_turn_back_to_the_heading_after_a_push_that_yaws_them():
     spins G1's feet 10-20 deg off the planner's heading. Each swing sole leaves the
     ground at the yaw it stood at and turns to the heading over the swing, so after the
     most turned landing each sole lands nearer the heading than the one before (until
-    within 1 deg), within 2 deg by the fifth (measured, with the tests' pinned kernels: 12.7, 8.7, 7.0, 4.9,
-    2.5, 1.1 deg at 1cc7f20; 15.3, 9.9, 3.7, 2.1, 0.5, 0.1 at 7b11703). With the swing
-    target's yaw jumping to the heading at the step, the foot still loaded in the double
-    support was twisted, the new stance foot spun, and the soles landed 9-11 deg off for
-    the rest of the run (measured)."""
+    within 1 deg), within 2 deg by the fifth (measured, with the tests' pinned kernels:
+    12.7, 8.7, 7.0, 4.9, 2.5, 1.1 deg at 1cc7f20; 15.3, 9.9, 3.7, 2.1, 0.5, 0.1 at
+    7b11703). With the swing target's yaw jumping to the heading at the step, the foot
+    still loaded in the double support was twisted, the new stance foot spun, and the
+    soles landed 9-11 deg off for the rest of the run (measured)."""
     backend, config, initial = build_robot_backend("g1", "rsg")
     push = Push(3.15, np.array([0.0, -24.77]), 0.1)
     scenario = Scenario("push", 7.5, (push,), reference_mass=None)
