@@ -48,14 +48,14 @@ class RobotModel:
             foot: self.model.getFrameId(description.ankle_link(foot)) for foot in FEET
         }
         self.effort_limits = np.asarray(self.model.effortLimit[6:], float).copy()
-        # The two joints nearest each sole (ankle pitch and roll on G1 and Talos).
-        self._ankle_joints = set()
+        # The two joints nearest each sole (ankle pitch and roll on G1 and Talos): (pitch, roll).
+        self._ankle_pairs = []
         for frame in self._ankle_frames.values():
             joint = self.model.frames[frame].parentJoint
-            self._ankle_joints |= {
-                self.model.names[joint],
-                self.model.names[self.model.parents[joint]],
-            }
+            self._ankle_pairs.append(
+                (self.model.names[self.model.parents[joint]], self.model.names[joint])
+            )
+        self._ankle_joints = {name for pair in self._ankle_pairs for name in pair}
         self.q = pinocchio.neutral(self.model)
         self.v = np.zeros(self.model.nv)
 
@@ -66,6 +66,15 @@ class RobotModel:
     def is_ankle(self, joint: str) -> bool:
         """Whether ``joint`` is one of the two joints nearest a sole."""
         return joint in self._ankle_joints
+
+    def ankle_effort_limits(self) -> tuple[float, float]:
+        """Effort limits [N m] of the ankles' roll and pitch joints (the two nearest each
+        sole), the smaller of the two feet's."""
+        limit = dict(zip(self.joint_names, self.effort_limits.tolist(), strict=True))
+        return (
+            min(limit[roll] for _, roll in self._ankle_pairs),
+            min(limit[pitch] for pitch, _ in self._ankle_pairs),
+        )
 
     def index_of(self, names: Sequence[str]) -> NDArray[np.intp]:
         """Positions in ``joint_names`` of each of ``names``."""

@@ -112,7 +112,9 @@ class WholeBodyController:
         )
         self.landing = Landing(config.landing_depth, timing.double_support)
         self.limits = ContactLimits(
-            description.sole, friction=config.friction, ankle_torque=ankle_limits(self.model, legs)
+            description.sole,
+            friction=config.friction,
+            ankle_torque=self.model.ankle_effort_limits(),
         )
         self.stiffness, self.damping = joint_impedance(self.model, description)
         self._ankle_height = -float(description.sole_offset[2])
@@ -357,15 +359,6 @@ class WholeBodyController:
                 self.description.rotational_height,
             )
         return MeasuredState(state.time, state.com[:2].copy(), velocity, swing_contact, sole)
-
-
-def ankle_limits(model: RobotModel, legs: dict[str, list[str]]) -> tuple[float, float]:
-    """The ankles' roll and pitch effort limits [N m] (the smaller of the two feet's):
-    the last two joints of each leg, pitch then roll."""
-    limits = model.effort_limits
-    roll = min(float(limits[model.joint_names.index(legs[f][-1])]) for f in ("left", "right"))
-    pitch = min(float(limits[model.joint_names.index(legs[f][-2])]) for f in ("left", "right"))
-    return roll, pitch
 
 
 def joint_impedance(
