@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
+from app.setup.robot_config import planner_config_for
 from app.stabilizer.wrench_distribution import (
     ContactLimits,
     FootContact,
@@ -17,6 +18,8 @@ from app.stabilizer.wrench_distribution import (
     center_of_pressure,
     distribute_wrench,
 )
+from kinematics.robot_model import RobotModel
+from planner.parameters import GRAVITY
 from robots import get_robot
 
 SOLE = get_robot("g1").sole
@@ -302,3 +305,21 @@ def test_no_ankle_is_given_more_torque_than_its_effort_limit(count):
             (free,) = distribute_wrench(contacts, force, toe, LIMITS)
             assert abs(ankle_torque(front, free)[1]) > 36.0, f"{case=}"
             assert abs(ankle_torque(front, wrenches[0])[1]) == pytest.approx(35.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("robot", ["g1", "talos"])
+def test_every_zmp_of_the_planners_window_is_a_cop_the_stance_ankle_holds(robot):
+    """Under the robot's weight, a ZMP at any corner of the planner's window is the CoP
+    the single support's wrench gets: the ankles' effort limits do not move it inwards
+    (G1's ankles, 35 N m, hold the CoP 0.107 m ahead of the ankle; its sole reaches 0.12)."""
+    description = get_robot(robot)
+    constraints = planner_config_for(description, description.total_mass).constraints
+    limits = ContactLimits(
+        description.sole, ankle_torque=RobotModel(description).ankle_effort_limits()
+    )
+    contact = FootContact(np.zeros(3), 0.0, -description.sole_offset[2])
+    weight = np.array([0.0, 0.0, description.total_mass * GRAVITY])
+    low, high = constraints.zmp_window_min, constraints.zmp_window_max
+    for corner in [(x, y) for x in (low[0], high[0]) for y in (low[1], high[1])]:
+        wrench = distribute_wrench([contact], weight, np.array(corner), limits)[0]
+        np.testing.assert_allclose(center_of_pressure([contact], [wrench]), corner, atol=1e-9)

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 
+from kinematics.robot_model import RobotModel
 from planner.parameters import (
+    GRAVITY,
     Constraints,
     GaitParameters,
     LipmModel,
@@ -16,10 +18,22 @@ from robots.description import RobotDescription
 ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the sole's edges
 
 
+def ankle_reach(description: RobotDescription, mass: float) -> tuple[float, float]:
+    """How far from the ankle [m] its joints hold the CoP under the robot's weight, along
+    x (pitch) and y (roll): each ankle's effort limit over m g."""
+    roll, pitch = RobotModel(description).ankle_effort_limits()
+    weight = mass * GRAVITY
+    return pitch / weight, roll / weight
+
+
 def planner_config_for(
     description: RobotDescription, mass: float, controller: str = "rsg"
 ) -> PlannerConfig:
     """The planner's parameters for a robot: its mass, CoM height, sole and gait.
+
+    The ZMP window is the sole, ``ZMP_MARGIN`` inside its edges, where the ankles can hold
+    the CoP under the robot's weight (:func:`ankle_reach`): the stabilizer never plans a
+    CoP beyond that, so the planner does not count on one.
 
     Args:
         description: The robot.
@@ -27,7 +41,8 @@ def planner_config_for(
         controller: ``rsg``, ``fixed-timing`` or ``no-step``.
     """
     sole = description.sole
-    half_width = sole.half_width - ZMP_MARGIN
+    reach_x, reach_y = ankle_reach(description, mass)
+    half_width = min(sole.half_width, reach_y) - ZMP_MARGIN
     return PlannerConfig(
         model=LipmModel(mass=mass, com_height=description.pendulum_height),
         gait=GaitParameters(
@@ -37,8 +52,8 @@ def planner_config_for(
             single_support_duration=description.single_support_duration,
         ),
         constraints=Constraints(
-            zmp_window_min=(sole.x_min + ZMP_MARGIN, -half_width),
-            zmp_window_max=(sole.x_max - ZMP_MARGIN, half_width),
+            zmp_window_min=(max(sole.x_min, -reach_x) + ZMP_MARGIN, -half_width),
+            zmp_window_max=(min(sole.x_max, reach_x) - ZMP_MARGIN, half_width),
             angular_momentum_rate_max=description.angular_momentum_rate_max,
             step_min=description.step_min,
             step_max=description.step_max,
