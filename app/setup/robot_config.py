@@ -15,7 +15,7 @@ from planner.parameters import (
 )
 from robots.description import RobotDescription
 
-ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the sole's edges
+ZMP_MARGIN = 0.005  # [m] kept between the ZMP window and the edges of what holds the CoP
 
 
 def ankle_reach(description: RobotDescription, mass: float) -> tuple[float, float]:
@@ -31,9 +31,9 @@ def planner_config_for(
 ) -> PlannerConfig:
     """The planner's parameters for a robot: its mass, CoM height, sole and gait.
 
-    The ZMP window is the sole, ``ZMP_MARGIN`` inside its edges, where the ankles can hold
-    the CoP under the robot's weight (:func:`ankle_reach`): the stabilizer never plans a
-    CoP beyond that, so the planner does not count on one.
+    The ZMP window is the part of the sole where the ankles hold the CoP under the robot's
+    weight (:func:`ankle_reach`), ``ZMP_MARGIN`` inside its edges: the stabilizer never
+    plans a CoP beyond the ankles' reach, so the planner does not count on one.
 
     Args:
         description: The robot.
