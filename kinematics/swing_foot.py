@@ -12,10 +12,10 @@ Timing (s~ = time since the last step [s]), from the planner's model:
 
 Vertically the sole rises over ``ramp_time`` after the lift-off, keeps the apex height,
 and comes down over the last ``ramp_time`` before the landing (a swing shorter than two
-ramps is one ``sin^2`` arc), so a foothold the planner moves late in a long swing is
-reached in the air; on one arc over G1's 0.7 s nominal swing the sole is 1 cm high 0.1 s
-before the landing and touched down short of such a foothold. IHMC's swing likewise keeps
-the foot at its swing height between 15 % and 85 % of the step
+ramps is one ``sin^2`` arc). A foothold the planner moves late in a long swing is then
+reached in the air: on one arc over G1's 0.7 s nominal swing the sole is 1 cm high 0.1 s
+before the landing, touches down short of a foothold moved then and stays there, as
+IHMC's swing keeps the foot at its swing height between 15 % and 85 % of the step
 (``SwingTrajectoryParameters.getSwingWaypointProportions``).
 
 Measured on G1: arriving horizontally at the ready time (0.2 s after lift-off)
