@@ -3,20 +3,12 @@
 Timing (s~ = time since the last step [s]), from the planner's model:
 
 * ``s~ < T_DSP``: double support, the foot stays on the ground;
-* ``T_DSP <= s~ <= landing``: the foot lifts (``sin^2`` edges, up to
-  ``apex_height``) and touches the ground with zero vertical velocity at
+* ``T_DSP <= s~ <= landing``: the foot lifts (``sin^2`` profile, apex
+  ``apex_height`` half-way) and touches the ground with zero vertical velocity at
   ``landing`` = the planner's planned step time when the caller knows it, else
   the nominal step time T_DSP + T_SSP. Horizontally it arrives above the landing
   target ``arrival_lead`` before landing, never earlier than the ready time
   T_DSP + T_SP.
-
-Vertically the sole rises over ``ramp_time`` after the lift-off, keeps the apex height,
-and comes down over the last ``ramp_time`` before the landing (a swing shorter than two
-ramps is one ``sin^2`` arc). A foothold the planner moves late in a long swing is then
-reached in the air: on one arc over G1's 0.7 s nominal swing the sole is 1 cm high 0.1 s
-before the landing, touches down short of a foothold moved then and stays there, as
-IHMC's swing keeps the foot at its swing height between 15 % and 85 % of the step
-(``SwingTrajectoryParameters.getSwingWaypointProportions``).
 
 Measured on G1: arriving horizontally at the ready time (0.2 s after lift-off)
 needs foot accelerations of ~30 m/s^2; the legs (7 kg each of 33 kg) then shift
@@ -84,27 +76,16 @@ class SwingTiming:
         return self.double_support + self.ready
 
 
-def swing_height(
-    time_since_step: float,
-    lift_off: float,
-    landing: float,
-    apex: float,
-    ramp: float | None = None,
-) -> float:
+def swing_height(time_since_step: float, lift_off: float, landing: float, apex: float) -> float:
     """Height of the swing sole above the ground [m] at s~ [s].
 
-    ``apex * sin^2(pi e / 2)`` with e = min(s~ - lift_off, landing - s~, r) / r clipped to
-    [0, 1] and r = min(``ramp``, half the swing) [s]: up over r, the apex in between,
-    down over the last r, with zero height and zero vertical velocity at both ends. With
-    ``ramp`` None (or at least half the swing) it is the arc ``apex sin^2(pi phase)``.
+    ``apex * sin^2(pi phase)`` with phase = (s~ - lift_off) / (landing - lift_off)
+    clipped to [0, 1]: zero height and zero vertical velocity at both ends.
     """
     if landing <= lift_off:
         return 0.0
-    half = 0.5 * (landing - lift_off)
-    edge = half if ramp is None else min(ramp, half)
-    since, left = time_since_step - lift_off, landing - time_since_step
-    progress = min(max(min(since, left, edge) / edge, 0.0), 1.0)
-    return apex * np.sin(0.5 * np.pi * progress) ** 2
+    phase = min(max((time_since_step - lift_off) / (landing - lift_off), 0.0), 1.0)
+    return apex * np.sin(np.pi * phase) ** 2
 
 
 def swing_yaw(
@@ -142,7 +123,6 @@ class SwingFootTrajectory:
         max_acceleration: float | None = None,
         descent_slope: float = 0.0,
         land_on_time: bool = False,
-        ramp_time: float | None = None,
     ) -> None:
         """Set the parameters.
 
@@ -161,8 +141,6 @@ class SwingFootTrajectory:
             land_on_time: The ``max_acceleration`` horizon never reaches past the
                 landing time: the foot is above the target when it lands, at the
                 cost of larger accelerations in its last moments.
-            ramp_time: Time [s] over which the sole rises after the lift-off and comes
-                down before the landing (None: one arc over the whole swing).
         """
         if not 0.0 < apex_height < 0.5:
             raise ParameterError("apex_height", apex_height, "0 < h < 0.5 m")
@@ -183,9 +161,6 @@ class SwingFootTrajectory:
             raise ParameterError("max_acceleration", max_acceleration, "> 0 m/s^2 or None")
         if not 0.0 <= descent_slope <= 10.0:
             raise ParameterError("descent_slope", descent_slope, "in [0, 10]")
-        if ramp_time is not None and not ramp_time > 0.0:
-            raise ParameterError("ramp_time", ramp_time, "> 0 s or None")
-        self.ramp_time = ramp_time
         self.max_acceleration = max_acceleration
         self.descent_slope = descent_slope
         self.land_on_time = land_on_time
@@ -238,9 +213,7 @@ class SwingFootTrajectory:
                 velocity = displacement / dt
             self.position[:2] = self.position[:2] + displacement
             self.velocity = velocity
-        height = swing_height(
-            time_since_step, timing.double_support, landing, self.apex_height, self.ramp_time
-        )
+        height = swing_height(time_since_step, timing.double_support, landing, self.apex_height)
         step_limit = self.max_vertical_speed * dt
         current = self.position[2] - self.ground_height
         if self.descent_slope > 0.0 and time_since_step > timing.double_support:

@@ -49,8 +49,6 @@ SWING_ACCELERATION = 20.0  # [m/s^2] bound on the swing sole's re-planned approa
 SWING_SPEED = 3.0  # [m/s] bound on the swing sole's speed: a catching step's foothold moves
 # up to 0.6 m with 0.2-0.3 s left, which at 2 m/s lands late (docs/notes/2026-12-06-swing-speed.md)
 SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
-SWING_RAMP = 0.2  # [s] the swing sole rises and comes down over this, at its apex between: a
-# foothold moved in a long swing's last 0.1 s is reached in the air (docs/full-robot.md)
 
 
 class WholeBodyController:
@@ -111,7 +109,6 @@ class WholeBodyController:
             max_acceleration=SWING_ACCELERATION,
             descent_slope=SWING_DESCENT_SLOPE,
             land_on_time=True,
-            ramp_time=SWING_RAMP,
         )
         self.landing = Landing(config.landing_depth, timing.double_support)
         self.limits = ContactLimits(
