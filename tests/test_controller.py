@@ -124,6 +124,41 @@ def test_the_feet_wrenches_are_bounded_by_the_ankles_effort_limits():
     assert talos.limits.ankle_torque == (100.0, 160.0)
 
 
+def test_a_landed_support_whose_load_dips_keeps_its_wrench():
+    """Double support, the planned CoP on the left sole: once the left foot has touched
+    down, a tick on which it carries nothing (a bounce, a CoM far from it) still gives it
+    a wrench that its leg presses with, while its sole is on the ground; lifted 2 cm, it
+    gets none, and the right foot carries the weight alone. A foot that has swung is not
+    pressed down before it touches the ground again."""
+    weight = G1.total_mass * GRAVITY
+    on_left = {"left": FootForce(0.0, LEFT.position), "right": FootForce(weight, RIGHT.position)}
+    for lift, pressed in ((0.0, True), (0.02, False)):
+        controller, measurement = standing()
+        controller.tick(measurement, command(0.0, np.zeros(2)))  # both feet loaded
+        later = dataclasses.replace(
+            measurement,
+            time=0.01,
+            foot_forces=on_left,
+            base_position=measurement.base_position + np.array([0.0, 0.0, lift]),
+        )
+        controller.tick(later, command(0.01, LEFT.position, since_step=0.01))
+        forces = controller.planned_forces
+        if pressed:
+            assert forces.get("left", 0.0) > 0.5 * weight, forces
+        else:
+            assert "left" not in forces and forces["right"] > 0.0, forces
+    # A foot that swung has to touch down again: at the step onto the right foot, which
+    # carries nothing yet, only the left is given the weight.
+    controller, measurement = standing()
+    controller.tick(measurement, command(0.0, np.zeros(2)))
+    swinging = {"left": FootForce(weight, LEFT.position), "right": FootForce(0.0, RIGHT.position)}
+    single = dataclasses.replace(measurement, time=0.01, foot_forces=swinging)
+    controller.tick(single, command(0.01, LEFT.position, since_step=0.3))
+    step = dataclasses.replace(single, time=0.02)
+    controller.tick(step, command(0.02, RIGHT.position, RIGHT, LEFT, since_step=0.0))
+    assert list(controller.planned_forces) == ["left"], controller.planned_forces
+
+
 def test_with_leg_odometry_the_tick_ignores_the_simulators_truth():
     """In ``odometry`` mode the base comes from the stance foot, the encoders and the
     IMU: a measurement whose truth fields (base position and velocity) are wrong

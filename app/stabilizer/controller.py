@@ -42,6 +42,9 @@ from planner.types import Foot, MeasuredState, PlannerOutput, other_foot
 from robots.description import RobotDescription
 
 CONTACT_LOAD = 0.05  # [-, of m g] a foot carrying more is on the ground
+# [m] a planned support that has touched down stays a contact while its sole is this close
+# to the ground, its load dipping or not (docs/notes/2026-12-06-landed-contact.md)
+LANDED_HEIGHT = 0.01
 ACCELERATION_FILTER = 0.02  # [s] low-pass of the IK's joint accelerations (not the swing leg's)
 ACCELERATION_LIMIT = 50.0  # [rad/s^2] bound on the feed-forward joint accelerations (idem)
 MOMENTUM_FILTER = 0.05  # [s] low-pass of the IK motion's angular momentum rate
@@ -144,6 +147,7 @@ class WholeBodyController:
         }
         self.failure: str | None = None
         self._contacts: list[FootContact] = []
+        self._landed: set[Foot] = {"left", "right"}  # supports that touched down since planned
 
     def reset(
         self,
@@ -294,14 +298,27 @@ class WholeBodyController:
     def _contact_wrenches(
         self, command: PlannerOutput, measurement: RobotMeasurement, force: NDArray[np.float64]
     ) -> tuple[list[Foot], list[NDArray[np.float64]]]:
-        """The planned supports that touch the ground (else the feet that do; in the
-        air, the stance foot) and the wrench each is given."""
+        """The planned supports on the ground (else the feet that touch it; in the air,
+        the stance foot) and the wrench each is given.
+
+        A planned support is on the ground while it carries load or, once it has touched
+        down, while its sole is within ``LANDED_HEIGHT`` of the ground: a new stance foot
+        whose load dips after its touchdown (a bounce, or a CoM far from it after a
+        crossing step) keeps its wrench, so its leg's feed-forward presses it down."""
         threshold = CONTACT_LOAD * self.mass * GRAVITY
         planned: list[Foot] = ["left", "right"] if command.double_support else [command.stance.foot]
         touching: list[Foot] = [
             f for f in ("left", "right") if measurement.normal_force(f) > threshold
         ]
-        feet = [f for f in planned if f in touching] or touching or [command.stance.foot]
+        self._landed.intersection_update(planned)  # a swinging foot has to touch down again
+        self._landed.update(f for f in touching if f in planned)
+        on_ground = [
+            f
+            for f in planned
+            if f in touching
+            or (f in self._landed and self.model.sole_frame(f)[0][2] < LANDED_HEIGHT)
+        ]
+        feet = on_ground or touching or [command.stance.foot]
         contacts = []
         for foot in feet:
             position, rotation = self.model.sole_frame(foot)
