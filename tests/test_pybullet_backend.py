@@ -390,8 +390,9 @@ def test_the_physics_log_records_where_the_soles_were_sent(tmp_path):
 
 
 def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):
-    """physics.png: each foot's measured and planned normal force, and the feet's net CoP
-    (their forces' weighted mean) against the planned CoP, at the log's times."""
+    """physics.png: each foot's measured and planned normal force, the feet's net CoP
+    (their forces' weighted mean) against the planned CoP, and each sole's tilt and yaw in
+    degrees, at the log's times."""
     from app.backends.physics_log import COLUMNS
     from app.results.physics_plot import plot_physics
 
@@ -399,7 +400,7 @@ def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):
     column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
     figure = plot_physics(rows, tmp_path / "physics.png")
     assert (tmp_path / "physics.png").read_bytes()[:4] == b"\x89PNG"
-    forces, cop_x, cop_y = figure.axes
+    forces, cop_x, cop_y, angles = figure.axes
     lines = {line.get_label(): line for line in forces.lines}
     for foot in ("left", "right"):
         np.testing.assert_array_equal(lines[f"{foot}, measured"].get_xdata(), column["t"])
@@ -415,3 +416,83 @@ def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):
         )
         np.testing.assert_allclose(measured.get_ydata(), moments / total)
         np.testing.assert_array_equal(planned.get_ydata(), column[f"planned_cop_{axis}"])
+    lines = {line.get_label(): line for line in angles.lines}
+    for foot in ("left", "right"):
+        for angle in ("tilt", "yaw"):
+            line = lines[f"{foot}, {angle}"]
+            np.testing.assert_array_equal(line.get_xdata(), column["t"])
+            np.testing.assert_allclose(line.get_ydata(), np.degrees(column[f"{foot}_sole_{angle}"]))
+
+
+def test_the_physics_log_shows_a_loaded_sole_on_its_edge(backend):
+    """The soles' angles in the log against the ground's CoP. Standing (after 0.1 s of
+    settling from the reset), both soles are flat and head along x. Pushed sideways with 400 N for 0.1 s, G1 falls over its feet,
+    which roll onto their edges: wherever a sole carrying load is tilted by more than 3 deg,
+    its CoP is within 5 mm of the sole's contact rectangle (a rigid sole tilted on flat
+    ground touches it only along an edge)."""
+    from app.backends.physics_log import COLUMNS, PhysicsLog
+
+    state = backend.reset(STANDING)
+    backend.physics_log = PhysicsLog()
+    try:
+        stand(backend, state, 1.5, lambda t: np.array([0.0, 400.0]) * (0.2 <= t < 0.3))
+        rows = np.array(backend.physics_log.rows)
+    finally:
+        backend.physics_log = None
+    assert backend.fall_status().fell
+    column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    sole = backend.description.sole
+    loaded = 0.05 * backend.mass * GRAVITY  # [N] the controller's contact threshold
+    on_edge = 0
+    for foot in ("left", "right"):
+        tilt, yaw = column[f"{foot}_sole_tilt"], column[f"{foot}_sole_yaw"]
+        carrying = column[f"{foot}_fz"] > loaded
+        before = carrying & (column["t"] >= 0.1) & (column["t"] < 0.2)  # standing, settled
+        assert before.sum() >= 45, foot  # [physics steps]
+        assert np.degrees(tilt[before]).max() < 0.5, foot
+        assert np.degrees(np.abs(yaw[before])).max() < 0.5, foot
+        tilted = carrying & (tilt > np.radians(3.0))
+        on_edge += int(tilted.sum())
+        dx = column[f"{foot}_cop_x"][tilted] - column[f"{foot}_sole_x"][tilted]
+        dy = column[f"{foot}_cop_y"][tilted] - column[f"{foot}_sole_y"][tilted]
+        c, s = np.cos(yaw[tilted]), np.sin(yaw[tilted])
+        x, y = c * dx + s * dy, -s * dx + c * dy  # the CoP in the sole's frame [m]
+        to_edge = np.min(
+            np.abs([x - sole.x_min, x - sole.x_max, y - sole.half_width, y + sole.half_width]),
+            axis=0,
+        )
+        assert np.all(to_edge < 0.005), (foot, to_edge.max(initial=0.0))
+    assert on_edge > 20  # the fall rolls the soles onto their edges
+
+
+def test_the_physics_log_writes_each_soles_tilt_and_yaw():
+    """The angles written for a sole turned 20 deg to the left about the vertical and then
+    rolled 10 deg about its own forward axis: tilt 10 deg, yaw 20 deg (a sole's yaw is
+    its forward axis's heading from the world's x, counter-clockwise seen from above)."""
+    from app.backends.physics_log import COLUMNS, PhysicsLog
+    from kinematics.whole_body_ik import yaw_rotation
+
+    roll = np.radians(10.0)
+    rolled = np.array(
+        [[1.0, 0.0, 0.0], [0.0, np.cos(roll), -np.sin(roll)], [0.0, np.sin(roll), np.cos(roll)]]
+    )
+    turned = {"left": yaw_rotation(np.radians(20.0)) @ rolled, "right": np.eye(3)}
+
+    class Ground:  # what the log reads of the simulator, with known sole frames
+        time = 0.5
+
+        def com_state(self):
+            return np.zeros(3), np.zeros(3)
+
+        def foot_pressure(self):
+            return {}
+
+        def sole_frame(self, foot, forward_kinematics=True):
+            return np.zeros(3), turned[foot]
+
+    log = PhysicsLog()
+    log.record(Ground(), None)
+    row = dict(zip(COLUMNS, log.rows[0], strict=True))
+    assert np.degrees(row["left_sole_tilt"]) == pytest.approx(10.0)
+    assert np.degrees(row["left_sole_yaw"]) == pytest.approx(20.0)
+    assert row["right_sole_tilt"] == pytest.approx(0.0) and row["right_sole_yaw"] == 0.0

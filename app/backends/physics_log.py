@@ -5,7 +5,9 @@ takes the weight within a few milliseconds, an impact of several kN can throw th
 whole robot off the ground for tens of milliseconds, and the feet can rock in turn.
 ``rsg run --physics-log`` records, after every physics step, the whole-body CoM
 position and velocity, each foot's normal force and CoP, and each sole's position,
-to ``physics.csv`` (SI units), so such events can be seen and measured; next to them,
+its tilt from flat and its yaw, to ``physics.csv`` (SI units), so such events can be
+seen and measured (a sole that rolls onto an edge, or turns on the ground under a
+push's yaw moment, turns the whole robot about it); next to them,
 what the controller asked for over that tick: the CoP and each foot's normal force of
 the wrench distribution, and where it asked the IK to put each sole (so a gap between
 plan and ground shows where it arises: a sole that lands off its target, a load the
@@ -44,12 +46,16 @@ COLUMNS = (
     "left_fz_planned",
     "right_fz_planned",
     *(f"{foot}_sole_target_{a}" for foot in ("left", "right") for a in "xyz"),
+    *(f"{foot}_sole_{angle}" for foot in ("left", "right") for angle in ("tilt", "yaw")),
 )
 
 
 class PhysicsLog:
     """Rows of :data:`COLUMNS`, one per physics step (a foot without contact has
-    zero force and its CoP as NaN; a foot given no wrench has a planned force of 0)."""
+    zero force and its CoP as NaN; a foot given no wrench has a planned force of 0).
+
+    A sole's tilt [rad] is the angle between its normal and the vertical (0: flat), its
+    yaw [rad] the angle of its forward axis about the vertical from the world's x."""
 
     def __init__(self) -> None:
         self.rows: list[list[float]] = []
@@ -77,11 +83,17 @@ class PhysicsLog:
         for foot in ("left", "right"):
             cop, force = pressure.get(foot, (np.full(2, np.nan), 0.0))
             row += [force, *cop]
-        for foot in ("left", "right"):
-            row += list(sim.sole_position(foot, forward_kinematics=False))
+        frames = [sim.sole_frame(foot, forward_kinematics=False) for foot in ("left", "right")]
+        for position, _ in frames:
+            row += list(position)
         push = np.zeros(2) if push_force is None else np.asarray(push_force, float)[:2]
         row += list(push)
         row += self._plan
+        for _, rotation in frames:
+            row += [
+                float(np.arccos(np.clip(rotation[2, 2], -1.0, 1.0))),
+                float(np.arctan2(rotation[1, 0], rotation[0, 0])),
+            ]
         self.rows.append([float(value) for value in row])
 
     def write(self, path: Path) -> Path:

@@ -1,9 +1,11 @@
 """``physics.png``: the ground's forces and CoP against what the controller asked for.
 
 Drawn from a run's physics log (:mod:`app.backends.physics_log`), one point per physics
-step: each foot's measured normal force with its distributed one, and the net CoP of the
-feet (x and y) with the planned CoP. Where the two part, the robot is not doing what the
-stabilizer planned (a swing sole pressing before the step, a sole rocking on an edge).
+step: each foot's measured normal force with its distributed one, the net CoP of the
+feet (x and y) with the planned CoP, and each sole's tilt and yaw. Where the plan and the
+ground part, the robot is not doing what the stabilizer planned (a swing sole pressing
+before the step, a sole rocking on an edge); a loaded sole that tilts is on an edge, and
+one whose yaw moves turns on the ground.
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ def plot_physics(rows: NDArray[np.float64], path: Path, title: str = "") -> plt.
     column = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
     t = column["t"]
     cop = net_cop(column)
-    fig, axes = plt.subplots(3, 1, figsize=(10, 7.5), sharex=True)
+    fig, axes = plt.subplots(4, 1, figsize=(10, 10), sharex=True)
     for foot, colour in FOOT_COLOURS.items():
         axes[0].plot(t, column[f"{foot}_fz"], color=colour, lw=1, label=f"{foot}, measured")
         axes[0].plot(
@@ -54,7 +56,20 @@ def plot_physics(rows: NDArray[np.float64], path: Path, title: str = "") -> plt.
         ax.plot(t, cop[:, index], color="black", lw=1, label="net CoP, measured")
         ax.plot(t, column[f"planned_cop_{axis}"], color="tab:red", lw=1, ls="--", label="planned")
         ax.set_ylabel(f"CoP {axis} [m]")
-    axes[2].set_xlabel("t [s]")
+    for foot, colour in FOOT_COLOURS.items():
+        axes[3].plot(
+            t, np.degrees(column[f"{foot}_sole_tilt"]), color=colour, lw=1, label=f"{foot}, tilt"
+        )
+        axes[3].plot(
+            t,
+            np.degrees(column[f"{foot}_sole_yaw"]),
+            color=colour,
+            lw=1,
+            ls=":",
+            label=f"{foot}, yaw",
+        )
+    axes[3].set_ylabel("sole angle [deg]")
+    axes[3].set_xlabel("t [s]")
     for ax in axes:
         ax.legend(loc="upper right", fontsize=8, ncol=2)
     axes[0].set_title(f"ground against plan, each physics step{': ' + title if title else ''}")
