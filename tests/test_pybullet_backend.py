@@ -426,10 +426,11 @@ def test_the_physics_plot_draws_the_logs_forces_and_cops(pushed_runs, tmp_path):
 
 def test_the_physics_log_shows_a_loaded_sole_on_its_edge(backend):
     """The soles' angles in the log against the ground's CoP. Standing (after 0.1 s of
-    settling from the reset), both soles are flat and head along x. Pushed sideways with 400 N for 0.1 s, G1 falls over its feet,
-    which roll onto their edges: wherever a sole carrying load is tilted by more than 3 deg,
-    its CoP is within 5 mm of the sole's contact rectangle (a rigid sole tilted on flat
-    ground touches it only along an edge)."""
+    settling from the reset), both soles are flat and head along x. Pushed sideways with
+    400 N for 0.1 s, G1 falls over its feet, which roll onto their edges: wherever a sole
+    carrying load is tilted by 3-10 deg, its CoP is within 5 mm of the edge of the sole's
+    contact rectangle (a rigid sole tilted on flat ground touches it only along an edge;
+    the rectangle is taken flat, which up to 10 deg shortens it by less than 2 mm)."""
     from app.backends.physics_log import COLUMNS, PhysicsLog
 
     state = backend.reset(STANDING)
@@ -451,7 +452,7 @@ def test_the_physics_log_shows_a_loaded_sole_on_its_edge(backend):
         assert before.sum() >= 45, foot  # [physics steps]
         assert np.degrees(tilt[before]).max() < 0.5, foot
         assert np.degrees(np.abs(yaw[before])).max() < 0.5, foot
-        tilted = carrying & (tilt > np.radians(3.0))
+        tilted = carrying & (tilt > np.radians(3.0)) & (tilt < np.radians(10.0))
         on_edge += int(tilted.sum())
         dx = column[f"{foot}_cop_x"][tilted] - column[f"{foot}_sole_x"][tilted]
         dy = column[f"{foot}_cop_y"][tilted] - column[f"{foot}_sole_y"][tilted]
