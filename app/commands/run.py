@@ -71,7 +71,8 @@ outputs in --out (a folder with an earlier run's results is refused without --ov
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
   replay.npz       the run for the browser: rsg replay FOLDER
   physics.csv      with --physics-log: every physics step, the ground against the plan
-  physics.png      with --physics-log: the feet's forces and CoP against the plan
+  physics.png      with --physics-log: the feet's forces and CoP against the plan, the
+                   soles' tilt and yaw
 
 exit code: 0 recovered, 1 not recovered, 2 bad input, 130 interrupted (Ctrl-C: what was
 simulated is written, summary.json says "interrupted": true)
@@ -135,10 +136,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--physics-log",
         action="store_true",
-        help="also write physics.csv: CoM, foot forces and CoPs, soles, and the "
-        "controller's planned CoP, foot forces and sole targets at every physics step "
-        "(--model pybullet; touchdowns and impacts), and physics.png: the feet's forces "
-        "and CoP against the plan",
+        help="also write physics.csv: CoM, foot forces and CoPs, soles (position, tilt, "
+        "yaw), and the controller's planned CoP, foot forces and sole targets at every "
+        "physics step (--model pybullet; touchdowns and impacts), and physics.png: the "
+        "feet's forces and CoP against the plan, the soles' tilt and yaw",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
