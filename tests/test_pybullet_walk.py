@@ -392,6 +392,37 @@ def test_the_net_force_holds_the_com_height_through_a_hard_forward_push():
     assert max(abs(h - nominal) for h in heights) < 0.015, (min(heights), max(heights))
 
 
+def test_a_catching_sole_that_carries_less_than_planned_stays_flat():
+    """35.8 N s forward early in the right foot's single support: the left foot's catching
+    step lands 0.35 m ahead of a CoM moving at 1 m/s and, over its first moments on the
+    ground, carries less than the force it is planned for. Its ankle's moment is bounded
+    by the force it carries (``within_sole_at_force``), so within 0.15 s of its touchdown
+    the sole tilts less than 4 deg and its origin stays within 5 mm of the ground
+    (measured 1.4 deg and 0.1 mm; with the moment of the planned force 6.9 deg and 12 mm:
+    the ankle turned the foot onto its toe)."""
+    push = Push(2.6, np.array([35.8, 0.0]), 0.1)
+    touchdown: list[float] = []
+    tilts: list[float] = []  # [deg] the left sole's, from its touchdown on
+    heights: list[float] = []  # [m] its origin's
+
+    def observe(out: PlannerOutput, backend: Any) -> None:
+        if out.time < push.time + 0.1:
+            return
+        load = backend.foot_pressure().get("left", (None, 0.0))[1]
+        if not touchdown and load > 0.05 * backend.mass * 9.81:  # the controller's contact
+            touchdown.append(out.time)
+        if touchdown and out.time <= touchdown[0] + 0.15:
+            position, rotation = backend.controller.model.sole_frame("left")
+            tilts.append(float(np.degrees(np.arccos(min(rotation[2, 2], 1.0)))))
+            heights.append(float(position[2]))
+
+    run_g1(Scenario("push", push.time + 0.7, (push,), reference_mass=None), observe=observe)
+    assert touchdown and 2.75 < touchdown[0] < 2.95, touchdown
+    assert len(tilts) >= 14
+    assert max(tilts) < 4.0, max(tilts)
+    assert max(heights) < 0.005, max(heights)
+
+
 @pytest.fixture(scope="module")
 def issue_pushes():
     """The issue's pushes, run as ``rsg grid --impulses 10 --controllers rsg,no-step`` runs

@@ -17,6 +17,7 @@ from app.stabilizer.wrench_distribution import (
     WrenchDistributionError,
     center_of_pressure,
     distribute_wrench,
+    within_sole_at_force,
 )
 from kinematics.robot_model import RobotModel
 from planner.parameters import GRAVITY
@@ -323,3 +324,35 @@ def test_every_zmp_of_the_planners_window_is_a_cop_the_stance_ankle_holds(robot)
     for corner in [(x, y) for x in (low[0], high[0]) for y in (low[1], high[1])]:
         wrench = distribute_wrench([contact], weight, np.array(corner), limits)[0]
         np.testing.assert_allclose(center_of_pressure([contact], [wrench]), corner, atol=1e-9)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.6])
+def test_a_foot_carrying_less_than_planned_keeps_its_cop_on_the_sole(yaw):
+    """A single-support wrench planned for m g with its CoP 0.1 m ahead of the ankle and
+    0.02 m inward: on a foot carrying a third of that, its CoP at the carried force ends
+    on the sole's front edge and at 0.02 m (within the half width); the force and the
+    torsion are kept. Carried in full, the wrench is unchanged; carried not at all, it
+    has no roll or pitch moment."""
+    contact = FootContact(np.array([0.3, -0.1, 0.0]), yaw, ANKLE_HEIGHT)
+    R = rotation(yaw)
+    offset = np.array([0.1, 0.02, 0.0])
+    wrench = distribute_wrench(
+        [contact],
+        np.array([10.0, -5.0, WEIGHT]),
+        contact.sole_point[:2] + (R @ offset)[:2],
+        dataclasses.replace(LIMITS, ankle_torque=(np.inf, np.inf)),
+    )[0]
+    assert np.allclose(wrench[:3], [10.0, -5.0, WEIGHT])
+
+    carried = WEIGHT / 3.0
+    bounded = within_sole_at_force(contact, wrench, carried, SOLE)
+    np.testing.assert_allclose(bounded[:3], wrench[:3])
+    local = R.T @ bounded[3:]
+    cop = np.array([-local[1], local[0]]) / carried  # in the sole's frame, at the carried force
+    assert cop[0] == pytest.approx(SOLE.x_max)
+    assert cop[1] == pytest.approx(min(offset[1] * 3.0, SOLE.half_width))
+    assert local[2] == pytest.approx((R.T @ wrench[3:])[2])
+
+    np.testing.assert_allclose(within_sole_at_force(contact, wrench, WEIGHT, SOLE), wrench)
+    unloaded = R.T @ within_sole_at_force(contact, wrench, 0.0, SOLE)[3:]
+    np.testing.assert_allclose(unloaded[:2], 0.0, atol=1e-12)

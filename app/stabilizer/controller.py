@@ -30,6 +30,7 @@ from app.stabilizer.wrench_distribution import (
     FootContact,
     WrenchDistributionError,
     distribute_wrench,
+    within_sole_at_force,
 )
 from kinematics.robot_model import RobotModel
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_yaw
@@ -333,6 +334,12 @@ class WholeBodyController:
             wrenches = [np.zeros(6) for _ in contacts]
         self._contacts = contacts
         self.planned_forces = {f: float(w[2]) for f, w in zip(feet, wrenches, strict=True)}
+        # A foot carrying less than planned (a bounce, a heel up) is not tipped onto its
+        # edge by its ankle's feed-forward: its CoP stays on the sole at the force it carries.
+        wrenches = [
+            within_sole_at_force(contact, wrench, measurement.normal_force(foot), self.limits.sole)
+            for foot, contact, wrench in zip(feet, contacts, wrenches, strict=True)
+        ]
         return feet, wrenches
 
     def _feedforward(

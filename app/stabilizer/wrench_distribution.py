@@ -18,6 +18,10 @@ momentum-based control framework and application to the humanoid robot Atlas", I
 tau_max / f_z, and a CoP beyond is moved towards the ankle with the force kept. The
 moments are taken about the ankle in the sole's axes, those of a flat foot's ankle
 joints. (As rows of the QP the limits led proxqp to declare feasible cases infeasible.)
+
+The controller then bounds each foot's moments by the normal force the foot is measured
+to carry (:func:`within_sole_at_force`): the feed-forward asks no ankle for a CoP off its
+sole when its foot carries less than planned.
 """
 
 from __future__ import annotations
@@ -236,6 +240,26 @@ def _within_ankle_reach(
     y_force = float(np.clip(moment[0], -roll - arm * force[1], roll - arm * force[1]))
     if x_force == -moment[1] and y_force == moment[0]:  # (the CoP's x and y times f'_z)
         return wrench
+    local_moment = np.array([y_force, -x_force, moment[2]])
+    return np.concatenate([wrench[:3], rotation @ local_moment])
+
+
+def within_sole_at_force(
+    contact: FootContact, wrench: NDArray[np.float64], normal_force: float, sole: SoleRectangle
+) -> NDArray[np.float64]:
+    """``wrench`` with its roll and pitch moments bounded so that its CoP under
+    ``normal_force`` [N], the force the foot carries, lies on ``sole``; its force kept.
+
+    A foot's ankle pushes its CoP no further than the sole's edge whatever force it is
+    planned for: a moment beyond what the carried force holds there turns the foot about
+    that edge (the foot-rotation indicator of Goswami, "Postural stability of biped
+    robots and the foot-rotation indicator (FRI) point", IJRR 1999).
+    """
+    rotation = _yaw_matrix(contact.yaw)
+    moment = rotation.T @ wrench[3:]
+    force = max(float(normal_force), 0.0)
+    x_force = float(np.clip(-moment[1], sole.x_min * force, sole.x_max * force))
+    y_force = float(np.clip(moment[0], -sole.half_width * force, sole.half_width * force))
     local_moment = np.array([y_force, -x_force, moment[2]])
     return np.concatenate([wrench[:3], rotation @ local_moment])
 
