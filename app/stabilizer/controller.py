@@ -6,7 +6,8 @@
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
 * stabilize: the pivot the planner commands, the CoP and net force that realise it and
   hold the CoM at the height the IK will be asked for (:mod:`.centroidal`), shared among
-  the feet on the ground (:mod:`.wrench_distribution`);
+  the feet on the ground, each foot's CoP on its sole at the force it carries
+  (:mod:`.wrench_distribution`);
 * IK: placo's whole-body IK, with the upper body as a flywheel for hdot
   (:mod:`kinematics.upper_body`);
 * actuate: per joint a target, stiffness, damping and the feed-forward torque from
