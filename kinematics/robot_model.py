@@ -26,6 +26,12 @@ from robots.urdf_cache import derived_urdf
 FEET = ("left", "right")
 
 
+def yaw_of(rotation: NDArray[np.float64]) -> float:
+    """Yaw [rad] of a frame with ``rotation`` (3x3): the heading of its x axis about the
+    world's vertical, counter-clockwise from the world's x."""
+    return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+
+
 class RobotModel:
     """pinocchio model and data of the robot with a floating base.
 

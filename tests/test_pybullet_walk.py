@@ -21,6 +21,8 @@ from app.runner import ClosedLoop, RunResult
 from app.scenarios import BUILT_IN, Scenario
 from app.setup.build import build_robot_backend
 from app.stabilizer.centroidal import momentum_velocity
+from app.stabilizer.controller import CONTACT_LOAD
+from planner.parameters import GRAVITY
 from planner.types import PlannerOutput, Push
 from robots import get_robot
 
@@ -409,7 +411,7 @@ def test_a_catching_sole_that_carries_less_than_planned_stays_flat():
         if out.time < push.time + 0.1:
             return
         load = backend.foot_pressure().get("left", (None, 0.0))[1]
-        if not touchdown and load > 0.05 * backend.mass * 9.81:  # the controller's contact
+        if not touchdown and load > CONTACT_LOAD * backend.mass * GRAVITY:
             touchdown.append(out.time)
         if touchdown and out.time <= touchdown[0] + 0.15:
             position, rotation = backend.controller.model.sole_frame("left")

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from app.backends.pybullet_robot import SimulatedRobot
+from kinematics.robot_model import yaw_of
 from planner.exceptions import RsgError
 from planner.types import Foot
 
@@ -92,7 +93,7 @@ class PhysicsLog:
         for _, rotation in frames:
             row += [
                 float(np.arccos(np.clip(rotation[2, 2], -1.0, 1.0))),
-                float(np.arctan2(rotation[1, 0], rotation[0, 0])),
+                yaw_of(rotation),
             ]
         self.rows.append([float(value) for value in row])
 

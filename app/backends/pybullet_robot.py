@@ -23,7 +23,7 @@ from numpy.typing import NDArray
 from app.backends.joint_motors import JointMotors
 from app.lowlevel import FootForce, JointCommand, RobotMeasurement
 from kinematics.native_output import native_output_silenced
-from kinematics.robot_model import RobotModel
+from kinematics.robot_model import RobotModel, yaw_of
 from robots.description import RobotDescription
 from robots.urdf_cache import derived_urdf
 
@@ -253,7 +253,7 @@ class SimulatedRobot:
     def sole_yaw(self, foot: str) -> float:
         """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
         _, rotation = self._foot_frame(foot, True)
-        return float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+        return yaw_of(rotation)
 
     # ------------------------------------------------------- torque control
     def measure(self) -> RobotMeasurement:

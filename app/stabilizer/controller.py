@@ -33,7 +33,7 @@ from app.stabilizer.wrench_distribution import (
     distribute_wrench,
     within_sole_at_force,
 )
-from kinematics.robot_model import RobotModel
+from kinematics.robot_model import RobotModel, yaw_of
 from kinematics.swing_foot import SwingFootTrajectory, SwingTiming, swing_yaw
 from kinematics.upper_body import UpperBodyFlywheel
 from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, leg_joints, sole_pose
@@ -227,7 +227,7 @@ class WholeBodyController:
         self.swing.start(self.model.sole_frame(swing)[0][:2])
         self.landing.start_swing()
         _, rotation = self.model.sole_frame(stance)
-        self._stance_yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+        self._stance_yaw = yaw_of(rotation)
         self._stance = stance
 
     def _sole_targets(
@@ -324,7 +324,7 @@ class WholeBodyController:
         contacts = []
         for foot in feet:
             position, rotation = self.model.sole_frame(foot)
-            yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+            yaw = yaw_of(rotation)
             ground_point = np.array([position[0], position[1], 0.0])
             contacts.append(FootContact(ground_point, yaw, self._ankle_height))
         try:
