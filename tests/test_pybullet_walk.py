@@ -22,6 +22,7 @@ from app.scenarios import BUILT_IN, Scenario
 from app.setup.build import build_robot_backend
 from app.stabilizer.centroidal import momentum_velocity
 from app.stabilizer.controller import CONTACT_LOAD
+from kinematics.robot_model import yaw_of
 from planner.parameters import GRAVITY
 from planner.types import PlannerOutput, Push
 from robots import get_robot
@@ -165,7 +166,7 @@ def test_a_fast_outward_step_does_not_turn_the_stance_foot():
             yaws.clear()
             return
         _, rotation = backend.controller.model.sole_frame(out.stance.foot)
-        yaws.append(float(np.degrees(np.arctan2(rotation[1, 0], rotation[0, 0]))))
+        yaws.append(float(np.degrees(yaw_of(rotation))))
 
     scenario = Scenario("push", push.time + 2.0, (push,), reference_mass=None)
     result, _ = run_g1(scenario, observe=observe)
