@@ -103,5 +103,5 @@ TALOS = RobotDescription(
     swing_preparation_time=0.5,
     filter_time_constant=0.01,
     step_reaction_time=0.2,
-    backend_options={"momentum_velocity": True, "height_frequency": 0.0},
+    backend_options={"height_frequency": 0.0},
 )

@@ -309,14 +309,13 @@ def test_the_stance_foots_measured_cop_follows_the_planned_one_on_the_walk():
 
 @pytest.mark.parametrize("robot", ["g1", "talos"])
 def test_the_momentum_velocity_moves_as_the_lipm_about_the_measured_cop(robot):
-    """Over 6 s of walking, the momentum velocity u (the angular momentum about the CoP
-    over m Z) changes within each 0.1 s as omega^2 (c - cop) of the measured CoP says,
-    closer than the CoM velocity does: the limbs' swing moves the CoM velocity, not u
-    (app/stabilizer/centroidal.py). The planner reads u where the robot's options say
-    so (Talos), else the CoM velocity (G1). Measured rms gaps (forward, sideways): G1
-    3 and 7 mm/s against the CoM velocity's 13 and 16; Talos 2 and 6 against 18 and 11."""
+    """Over 6 s of walking, the momentum velocity u (the angular momentum about the CoP over m
+    Z) changes within each 0.1 s as omega^2 (c - cop) of the measured CoP says, closer than
+    the CoM velocity does: the limbs' swing moves the CoM velocity, not u
+    (app/stabilizer/centroidal.py), and the planner reads u. Measured rms gaps (forward,
+    sideways): G1 3 and 7 mm/s against the CoM velocity's 13 and 16; Talos 2 and 6 against
+    18 and 11."""
     backend, config, initial = build_robot_backend(robot, "rsg")
-    options = backend.controller.config
     scenario = dataclasses.replace(BUILT_IN["walk"], duration=6.0)
     loop = ClosedLoop(backend, config, scenario, initial)
     omega2 = config.model.omega**2
@@ -337,7 +336,7 @@ def test_the_momentum_velocity_moves_as_the_lipm_about_the_measured_cop(robot):
                 backend.description.rotational_height,
             )
             read = loop.measured.com_velocity
-            np.testing.assert_array_equal(read, u if options.momentum_velocity else com_velocity)
+            np.testing.assert_array_equal(read, u)
             rows.append((*controller.state.com[:2], *u, *com_velocity, *cop))
             assert not backend.fall_status().fell
     finally:

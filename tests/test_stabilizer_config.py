@@ -22,7 +22,7 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 
 
 def test_every_number_option_has_a_range_and_the_defaults_are_in_it():
-    assert set(OPTION_NAMES) == {*RANGES, "estimator", "momentum_velocity"}
+    assert set(OPTION_NAMES) == {*RANGES, "estimator"}
     assert len(OPTION_NAMES) <= 12  # the issue: about a dozen options
     config = StabilizerConfig()
     for name, (low, high) in RANGES.items():
@@ -59,14 +59,6 @@ def test_the_estimator_is_truth_or_odometry(value):
     assert error.value.field == "estimator"
     assert "truth" in error.value.allowed and "odometry" in error.value.allowed
     assert StabilizerConfig(estimator="odometry").estimator == "odometry"
-
-
-@pytest.mark.parametrize("value", ["true", 1, None])
-def test_the_momentum_velocity_is_true_or_false(value):
-    with pytest.raises(ParameterError) as error:
-        StabilizerConfig(momentum_velocity=value)
-    assert error.value.field == "momentum_velocity" and error.value.value is value
-    assert StabilizerConfig(momentum_velocity=True).momentum_velocity is True
 
 
 def test_a_robots_backend_options_are_its_stabilizer_options():

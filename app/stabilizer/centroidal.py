@@ -41,10 +41,9 @@ constant height the velocity
     u = cdot + H^T (L - m h_r H cdot) / (m Z),      d/dt u = omega^2 (c - cop),
 
 moves as the LIPM's whatever the limbs do (L the centroidal angular momentum, Z the
-planner's pendulum height): it is the CoM velocity once the limbs' momentum is back in
-the CoM. :func:`momentum_velocity`; the planner reads it with the option
-``momentum_velocity`` (Orin, Goswami and Lee, "Centroidal dynamics of a humanoid robot",
-Auton. Robots 2013, for L).
+planner's pendulum height): it is the CoM velocity once the limbs' momentum is back in the
+CoM. :func:`momentum_velocity`; the planner reads it as its CoM velocity (Orin, Goswami and
+Lee, "Centroidal dynamics of a humanoid robot", Auton. Robots 2013, for L).
 """
 
 from __future__ import annotations

@@ -31,12 +31,6 @@ class StabilizerConfig:
             force, critically damped [rad/s] (0: the LIPM's m g): the feet's moments are
             planned for the force the legs will push with after a touchdown's bounce
             (docs/notes/2026-12-06-height-loop.md).
-        momentum_velocity: The planner reads the velocity of the angular momentum about
-            the CoP, u (:func:`app.stabilizer.centroidal.momentum_velocity`), instead of
-            the CoM velocity: what a swinging leg holds counts as the CoM velocity it
-            gives back. On for Talos (robots/talos.py); off for G1, whose upper-body
-            flywheel's momentum it counts with the limbs' (92 of 100 development pushes
-            recovered against 98; docs/notes/2026-12-05-momentum-about-the-cop.md).
     """
 
     estimator: str = "truth"
@@ -46,13 +40,10 @@ class StabilizerConfig:
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.75
     height_frequency: float = 10.0
-    momentum_velocity: bool = False
 
     def __post_init__(self) -> None:
         if self.estimator not in SOURCES:
             raise ParameterError("estimator", self.estimator, " or ".join(SOURCES))
-        if not isinstance(self.momentum_velocity, bool):
-            raise ParameterError("momentum_velocity", self.momentum_velocity, "true or false")
         for name, (low, high) in RANGES.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):

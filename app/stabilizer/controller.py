@@ -362,11 +362,11 @@ class WholeBodyController:
     def observe(
         self, measurement: RobotMeasurement, stance: Foot, double_support: bool
     ) -> MeasuredState:
-        """Estimate the state from ``measurement``; return what the planner reads: the
-        CoM, its velocity (with ``momentum_velocity``, that of the angular momentum
-        about the CoP) and, in single support, the stance sole (the planner
-        re-anchors its foothold there) and whether the swing sole touches the ground
-        (a step due before the touchdown waits for it)."""
+        """Estimate the state from ``measurement``; return what the planner reads: the CoM, the
+        velocity of the angular momentum about the CoP (u,
+        :func:`app.stabilizer.centroidal.momentum_velocity`) and, in single support, the
+        stance sole (the planner re-anchors its foothold there) and whether the swing sole
+        touches the ground (a step due before the touchdown waits for it)."""
         self.state = state = self.estimator.update(measurement, stance)
         sole, swing_contact = None, None
         threshold = CONTACT_LOAD * self.mass * GRAVITY
@@ -374,15 +374,13 @@ class WholeBodyController:
             if measurement.normal_force(stance) > threshold:
                 sole = self.model.sole_frame(stance)[0][:2].copy()
             swing_contact = measurement.normal_force(other_foot(stance)) > threshold
-        velocity = state.com_velocity[:2].copy()
-        if self.config.momentum_velocity:
-            velocity = centroidal.momentum_velocity(
-                velocity,
-                self.model.centroidal_angular_momentum()[:2],
-                self.mass,
-                self.lipm.com_height,
-                self.description.rotational_height,
-            )
+        velocity = centroidal.momentum_velocity(
+            state.com_velocity[:2],
+            self.model.centroidal_angular_momentum()[:2],
+            self.mass,
+            self.lipm.com_height,
+            self.description.rotational_height,
+        )
         return MeasuredState(state.time, state.com[:2].copy(), velocity, swing_contact, sole)
 
 
