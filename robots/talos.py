@@ -21,11 +21,7 @@ as the IK sways the CoM over the feet the body's angular momentum follows the Co
 velocity with h_r 0.121 m along x, 0.119 m along y (``kinematics/pendulum.py``; the 0.115 m
 used was measured along y while the IK still moved the arms, within 1 cm of both). The
 whole-body stabilizer's defaults, chosen on G1, are used (its joint gains follow from
-each joint's effort limit) but two: the planner reads the velocity of the angular
-momentum about the CoP (``momentum_velocity``): what its heavy swinging leg holds is
-counted as the CoM velocity it gives back (development pushes, seeds 1 and 3: 92 and 96
-of 100 recovered against 91 and 88, and 9 % fewer adjusted steps, 288 against 317;
-docs/notes/2026-12-05-momentum-about-the-cop.md); and its net force is the LIPM's m g
+each joint's effort limit) but one: its net force is the LIPM's m g
 (``height_frequency`` 0): G1's CoM height loop lowered its development grid
 (docs/notes/2026-12-06-height-loop.md). Talos lists no upper-body joints, so it has no
 flywheel and the whole hdot goes to the CoP (a flywheel of the torso and the shoulders did
