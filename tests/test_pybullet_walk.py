@@ -313,7 +313,7 @@ def test_the_momentum_velocity_moves_as_the_lipm_about_the_measured_cop(robot):
     Z) changes within each 0.1 s as omega^2 (c - cop) of the measured CoP says, closer than
     the CoM velocity does: the limbs' swing moves the CoM velocity, not u
     (app/stabilizer/centroidal.py), and the planner reads u. Measured rms gaps (forward,
-    sideways): G1 3 and 7 mm/s against the CoM velocity's 13 and 16; Talos 2 and 6 against
+    sideways): G1 4 and 9 mm/s against the CoM velocity's 17 and 18; Talos 2 and 6 against
     18 and 11."""
     backend, config, initial = build_robot_backend(robot, "rsg")
     scenario = dataclasses.replace(BUILT_IN["walk"], duration=6.0)
