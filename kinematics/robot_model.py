@@ -47,6 +47,7 @@ class RobotModel:
         urdf = derived_urdf(description, merged=True)
         self.model = pinocchio.buildModelFromUrdf(str(urdf), pinocchio.JointModelFreeFlyer())
         self.data = self.model.createData()
+        self._scratch = self.model.createData()  # for kinematics at other configurations
         self.joint_names = [self.model.names[i] for i in range(2, self.model.njoints)]
         self.mass = float(sum(inertia.mass for inertia in self.model.inertias))
         self.sole_offset = np.asarray(description.sole_offset, float)
@@ -114,6 +115,19 @@ class RobotModel:
         """World position [m] and rotation of ``foot``'s sole frame (after :meth:`update`)."""
         origin, rotation = self.ankle_frame(foot)
         return origin + rotation @ self.sole_offset, rotation
+
+    def sole_positions_at(self, q: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        """World position [m] of each foot's sole frame at the configuration ``q`` (the
+        state of :meth:`update` is left as it is)."""
+        data = self._scratch
+        pinocchio.framesForwardKinematics(self.model, data, q)
+        positions = {}
+        for foot, frame in self._ankle_frames.items():
+            placement = data.oMf[frame]
+            positions[foot] = np.asarray(
+                placement.translation + placement.rotation @ self.sole_offset, float
+            )
+        return positions
 
     def centroidal_angular_momentum(self) -> NDArray[np.float64]:
         """Angular momentum about the CoM [N m s], shape (3,), of the current state."""

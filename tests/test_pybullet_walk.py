@@ -131,6 +131,20 @@ def test_talos_catches_a_stance_side_push_with_a_wide_outward_step():
     assert result.recovered
 
 
+def test_talos_keeps_the_outward_reach_its_lean_gives_a_wide_catching_step():
+    """26 N s to the left early in a right single support (development push 26 of Talos's
+    seed 1): a 0.83 m outward step, after which Talos's pelvis rolls 10-17 deg. The swing
+    sole's correction for the body's tilt leaves alone the part that lengthens the step:
+    Talos recovers (measured: 3 adjusted steps in all). Correcting the whole offset, the
+    crossing sole after the wide step landed 16.8 cm off its foothold and Talos fell
+    (docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md)."""
+    push = Push(3.3744, np.array([5.2927, 25.5577]), 0.077)
+    result, _ = run_g1(Scenario("push", 8.0, (push,), reference_mass=None), robot="talos")
+    assert not result.fall.fell, result.fall.reason
+    assert max(abs(s.step[1]) for s in result.steps) > 0.8  # u_d,y [m]
+    assert result.recovered
+
+
 def test_g1_catches_a_stance_side_push_with_an_outward_step_wider_than_0_4_m():
     """9.6 N s toward the stance side in the single support (development push 26 of
     seed 1): G1 steps out more than 0.45 m (its bound is its legs' reach, 0.55 m),
@@ -203,6 +217,24 @@ def test_a_swing_sole_sent_elsewhere_by_a_push_follows_its_target():
     assert landed and landed[0] < 2.9, landed
     assert max(errors) < 0.038, max(errors)
     assert float(np.mean(errors)) < 0.016, np.mean(errors)
+
+
+def test_after_a_backward_push_at_mid_swing_the_soles_land_on_their_footholds():
+    """17.5 N s backward at 3.55 s, the left foot in mid-swing: the right foot, reversed,
+    catches the push (an adjusted step), and the body, leaning back on its stance ankle,
+    carries the swing leg forward of the IK's. With the swing sole's measured offset fed
+    back (``_swing_correction``), every later sole lands within 1.5 cm of its foothold
+    and the walk is nominal again (measured 1 cm, one adjusted step; without it the
+    soles landed 3-6 cm ahead and every step was adjusted to the end)."""
+    push = Push(3.55, np.array([-17.5, 0.0]), 0.1)
+    result, errors = run_g1(Scenario("push", 7.0, (push,), reference_mass=None))
+    assert result.recovered, result.fall.reason
+    steps = [s.event for s in result.steps]
+    catch = next(i for i, step in enumerate(steps) if step["t"] > push.time)
+    assert steps[catch]["adjusted"]
+    assert not any(step["adjusted"] for step in steps[catch + 2 :]), steps[catch:]
+    later = errors[catch + 1 :]  # errors[i] is steps[i]'s
+    assert len(later) >= 3 and max(later) < 0.015, errors
 
 
 def test_a_sole_landing_before_its_timing_jump_is_stepped_on_at_once():

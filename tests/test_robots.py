@@ -299,3 +299,26 @@ def test_each_leg_is_the_chain_from_the_pelvis_to_its_ankle(name):
         other = "right" if foot == "left" else "left"
         assert np.linalg.norm(model.sole_frame(foot)[0] - before[foot]) > 0.01
         np.testing.assert_allclose(model.sole_frame(other)[0], before[other], atol=1e-12)
+
+
+def test_sole_positions_at_another_configuration_leave_the_state_alone():
+    """``RobotModel.sole_positions_at(q)`` is forward kinematics at ``q``: the soles where
+    :meth:`update` with ``q`` puts them, and the model's own state, its frames included,
+    as it was."""
+    from kinematics.robot_model import RobotModel
+
+    model = RobotModel(get_robot("g1"))
+    rng = np.random.default_rng(0)
+    state = np.concatenate([[0.1, -0.2, 0.7, 0.0, 0.0, 0.0, 1.0], np.zeros(len(model.joint_names))])
+    model.update(state, np.zeros(model.nv))
+    before = {f: model.sole_frame(f)[0] for f in ("left", "right")}
+    other = state.copy()
+    other[7:] = rng.uniform(-0.3, 0.3, len(model.joint_names))
+    other[3:7] = [0.0, np.sin(0.1), 0.0, np.cos(0.1)]  # pitched 0.2 rad
+    moved = model.sole_positions_at(other)
+    for foot in ("left", "right"):
+        np.testing.assert_array_equal(model.sole_frame(foot)[0], before[foot])
+    assert all(np.linalg.norm(moved[f] - before[f]) > 0.01 for f in ("left", "right"))
+    model.update(other, np.zeros(model.nv))
+    for foot in ("left", "right"):
+        np.testing.assert_allclose(moved[foot], model.sole_frame(foot)[0], atol=1e-12)

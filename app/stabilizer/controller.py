@@ -4,6 +4,8 @@
 
 * measure: the state estimate (:mod:`.estimator`) from the measurement record;
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
+  the swing sole's IK target is corrected for the real body's tilt on its stance ankle
+  (:meth:`WholeBodyController._swing_correction`);
 * stabilize: the pivot the planner commands, the CoP and net force that realise it and
   hold the CoM at the height the IK will be asked for (:mod:`.centroidal`), shared among
   the feet on the ground, each foot's CoP on its sole at the force it carries
@@ -53,6 +55,7 @@ MOMENTUM_FILTER = 0.05  # [s] low-pass of the IK motion's angular momentum rate
 SWING_ACCELERATION = 20.0  # [m/s^2] bound on the swing sole's re-planned approach
 SWING_SPEED = 3.0  # [m/s] bound on the swing sole's speed: a catching step's foothold moves
 # up to 0.6 m with 0.2-0.3 s left, which at 2 m/s lands late (docs/notes/2026-12-06-swing-speed.md)
+SWING_CORRECTION_TIME = 0.05  # [s] low-pass of the swing sole's measured offset (impacts)
 SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
 
 
@@ -141,6 +144,7 @@ class WholeBodyController:
         self._ik_momentum: NDArray[np.float64] | None = None
         self._motion_momentum_rate = np.zeros(2)
         self._stance_yaw = 0.0  # [rad] the stance sole's yaw when it landed
+        self._swing_error = np.zeros(2)  # [m] see _swing_correction
         self._swing_start_yaw = 0.0  # [rad] the swing sole's yaw when it lifted off
         self.planned_cop = np.array(com_xy, dtype=float)
         self.planned_forces: dict[Foot, float] = {}
@@ -205,7 +209,9 @@ class WholeBodyController:
         com_target, _ = integrate_lipm(
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
-        # IK
+        # IK, the swing sole's target corrected for the real body's tilt on its stance ankle
+        soles[swing] = soles[swing].copy()
+        soles[swing][:2, 3] -= self._swing_correction(command, stance, swing)
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
         feet, wrenches = self._contact_wrenches(command, measurement, force)
@@ -258,6 +264,39 @@ class WholeBodyController:
             0.0,
         )
         return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position, yaw)}
+
+    def _swing_correction(
+        self, command: PlannerOutput, stance: Foot, swing: Foot
+    ) -> NDArray[np.float64]:
+        """How far [m] (x, y) the swing sole's IK target is moved so that the real sole lands
+        where the IK puts it relative to the stance sole: zero in the double support; in
+        single support the low-passed offset, relative to the measured stance sole, of the
+        real swing sole with the swing leg at the IK's angles (the body's tilt on its
+        stance ankle, which the IK's body does not have; the swing leg's own lag is the
+        feed-forward's) from the IK's, less the part that lengthens the step (a body leaning
+        into a push carries its swing sole further that way, which the planner's step does
+        not include and the recovery needs; docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md).
+        """
+        if command.double_support:
+            self._swing_error = np.zeros(2)
+            return self._swing_error
+        q = self.model.q.copy()
+        leg = self._legs[swing]
+        q[7 + leg] = self._targets[0][leg]
+        soles = self.model.sole_positions_at(q)
+        real = soles[swing][:2] - soles[stance][:2]
+        ik = self.ik.sole_world(swing)[:2, 3] - self.ik.sole_world(stance)[:2, 3]
+        error = real - ik
+        step = np.asarray(command.next_step.position, float) - np.asarray(
+            command.stance.position, float
+        )
+        length = float(np.linalg.norm(step))
+        if length > 1e-6:
+            along = float(error @ step) / length
+            error = error - max(along, 0.0) * step / length
+        gain = min(self.period / SWING_CORRECTION_TIME, 1.0)
+        self._swing_error = self._swing_error + gain * (error - self._swing_error)
+        return self._swing_error
 
     def _solve_ik(
         self,
