@@ -133,11 +133,11 @@ def test_talos_catches_a_stance_side_push_with_a_wide_outward_step():
 
 def test_talos_keeps_the_outward_reach_its_lean_gives_a_wide_catching_step():
     """26 N s to the left early in a right single support (development push 26 of Talos's
-    seed 1): a 0.83 m outward step, after which Talos's pelvis rolls 10-17 deg. The swing
-    sole's correction for the body's tilt leaves alone the part that lengthens the step:
-    Talos recovers (measured: 3 adjusted steps in all). Correcting the whole offset, the
-    crossing sole after the wide step landed 16.8 cm off its foothold and Talos fell
-    (docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md)."""
+    seed 1): a 0.83 m outward step. The swing sole's correction for the body's tilt leaves
+    alone the part that lengthens the step: Talos recovers (measured: 3 adjusted steps in
+    all). Correcting the whole offset, the pelvis rolled 10-17 deg after the wide step, the
+    correction chased the roll, the crossing sole landed 16.8 cm off its foothold and Talos
+    fell (docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md)."""
     push = Push(3.3744, np.array([5.2927, 25.5577]), 0.077)
     result, _ = run_g1(Scenario("push", 8.0, (push,), reference_mass=None), robot="talos")
     assert not result.fall.fell, result.fall.reason
