@@ -120,13 +120,13 @@ class RobotModel:
         """World position [m] of each foot's sole frame at the configuration ``q`` (the
         state of :meth:`update` is left as it is)."""
         data = self._scratch
-        pinocchio.framesForwardKinematics(self.model, data, q)
+        pinocchio.forwardKinematics(self.model, data, q)
         positions = {}
         for foot, frame in self._ankle_frames.items():
-            placement = data.oMf[frame]
-            positions[foot] = np.asarray(
-                placement.translation + placement.rotation @ self.sole_offset, float
-            )
+            placement = pinocchio.updateFramePlacement(self.model, data, frame)
+            origin = np.asarray(placement.translation, float)
+            rotation = np.asarray(placement.rotation, float)
+            positions[foot] = origin + rotation @ self.sole_offset
         return positions
 
     def centroidal_angular_momentum(self) -> NDArray[np.float64]:
