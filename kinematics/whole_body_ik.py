@@ -3,7 +3,7 @@
 The IK keeps its own kinematic model (floating base + joints) in the world frame
 of the simulation and moves it, once per control tick, so that:
 
-* the stance sole follows its pose exactly (hard frame task);
+* the stance soles follow their poses (soft, a hundred times the swing sole's weight);
 * the swing sole follows its pose (soft, high weight);
 * the CoM follows the target [m] (soft, high weight);
 * the trunk and the pelvis stay upright with the feet's mean yaw (soft);
@@ -21,6 +21,20 @@ of the simulation and moves it, once per control tick, so that:
   weight, in place of the trunk orientation task): the upper body turns as a
   flywheel (:mod:`kinematics.upper_body`) while the CoM task keeps the CoM where
   the plan wants it.
+
+Every task is soft and each step is damped as in the Levenberg-Marquardt method
+(Sugihara, "Solvability-unconcerned inverse kinematics by the Levenberg-Marquardt
+method", IEEE T-RO 2011), so that targets out of the legs' reach (a wide catching step,
+a stance sole slipped outwards) give the nearest posture rather than a jump. The damping
+weighs the joints' step in proportion to the feet's and the CoM's weighted squared error,
+as there, but the error the last step left rather than the present one: what persists
+from one solve to the next is the part out of reach, while targets that merely move (a
+settling sole, the CoM) are tracked undamped (damped by the present error, a sole moving
+1 cm a tick left the CoM height lagging, and it caught up in one 0.2 rad step). With the
+stance soles as hard tasks, placo's linearised step at the legs' reach (the knees at
+their margin, the ankle rolls at their limits) left the soles up to 37 cm off their targets
+and moved joint targets by up to 92 deg in one tick; soft but undamped, joint targets
+still jumped by radians a tick past the reach (docs/notes/2026-12-07-ik-at-the-legs-reach.md).
 
 Its output is the joint target vector of the joint motors' PD law.
 After each solve, :attr:`WholeBodyIK.angular_momentum` holds the centroidal
@@ -50,10 +64,10 @@ Support = Literal["left", "right", "both"]
 
 
 class IkInfeasibleError(RsgError):
-    """placo's QP found no joint motion meeting the hard tasks (feet, joint limits).
+    """placo's QP returned no joint motion (none within the joint limits, or NaN).
 
     Attributes:
-        support: The feet whose tasks were hard.
+        support: The feet the IK stood on.
         com_target: Horizontal CoM target of that solve [m].
         reason: placo's message.
     """
@@ -72,9 +86,14 @@ class IkInfeasibleError(RsgError):
 
 
 FOOT_WEIGHT = 1000.0  # soft swing-foot task weight [-]
+STANCE_WEIGHT = 1e5  # stance-foot task weight [-], above every other task's
 COM_WEIGHT = 100.0  # CoM task weight [-]
 TRUNK_WEIGHT = 10.0  # trunk and pelvis orientation weight [-]
 POSTURE_WEIGHT = 1e-2  # joint posture regularisation weight [-]
+# [-] the damping's weight per unit of the error left by the last step: the least of 1, 2 and
+# 4 at which the joints do not chatter with the soles beyond the legs' reach (at 2, Talos's
+# moved more than 5 deg in 9 ticks)
+DAMPING_GAIN = 4.0
 KNEE_MARGIN = 0.3  # [rad] least knee bend (0.2 rad still let a knee target flip)
 
 
@@ -200,11 +219,15 @@ class WholeBodyIK:
             held_task = self.solver.add_joints_task()
             held_task.set_joints({name: standing[name] for name in self.held_joints})
             held_task.configure("held", "soft", TRUNK_WEIGHT)
+        # Levenberg-Marquardt damping: a joints task on the present angles (see solve)
+        self.damping_task = self.solver.add_joints_task()
+        self.damping_task.configure("damping", "soft", 0.0)
         self.posture_task = self.solver.add_joints_task()
         self.posture_task.set_joints(standing)
         self.posture_task.configure("posture", "soft", POSTURE_WEIGHT)
         self.upper_body_posture = np.array([standing[name] for name in self.upper_body_joints])
         self._support: Support | None = None
+        self._residual = 0.0  # [-] task_error after the last solve
         self._previous_q: NDArray[np.float64] | None = None
         self.angular_momentum = np.zeros(3)
 
@@ -216,8 +239,8 @@ class WholeBodyIK:
         if support == self._support:
             return
         for foot, task in self.foot_tasks.items():
-            hard = support in (foot, "both")
-            task.configure(f"{foot}_foot", "hard" if hard else "soft", FOOT_WEIGHT, FOOT_WEIGHT)
+            weight = STANCE_WEIGHT if support in (foot, "both") else FOOT_WEIGHT
+            task.configure(f"{foot}_foot", "soft", weight, weight)
         self._support = support
 
     def reset(
@@ -245,11 +268,13 @@ class WholeBodyIK:
         base[:3, 3] = [*np.asarray(com_xy, float), self.description.com_height + 0.1]
         self.robot.set_T_world_fbase(base)
         self.robot.update_kinematics()
-        # Soft feet first: a far initial guess must not make hard tasks infeasible.
+        # Both feet at the swing sole's weight while converging from the initial guess.
         for foot, task in self.foot_tasks.items():
             task.configure(f"{foot}_foot", "soft", FOOT_WEIGHT, FOOT_WEIGHT)
         self._support = None
         self.angular_momentum = np.zeros(3)
+        self._residual = 0.0
+        self.damping_task.configure("damping", "soft", 0.0)  # converging from afar: undamped
         self.solver.dt = 0.01
         for _ in range(iterations):
             self._set_targets(com_xy, left_sole, right_sole)
@@ -300,7 +325,7 @@ class WholeBodyIK:
             com_xy: Horizontal CoM target in the world [m], shape (2,).
             left_sole: Left sole pose, 4x4 homogeneous [m].
             right_sole: Right sole pose, 4x4 homogeneous [m].
-            support: Feet on the ground (their tasks are hard).
+            support: Feet on the ground (their tasks weigh ``STANCE_WEIGHT``).
             dt: Time since the previous solve [s].
             upper_body_offsets: Offsets [rad] of :attr:`upper_body_joints` from
                 their standing angles, used when ``upper_body`` is enabled.
@@ -309,8 +334,8 @@ class WholeBodyIK:
             Joint angles [rad] in :attr:`joint_names` order.
 
         Raises:
-            IkInfeasibleError: placo's QP has no solution (the robot's configuration
-                is left as before the call).
+            IkInfeasibleError: placo's QP returned no solution (the robot's
+                configuration is left as before the call).
         """
         if support not in ("left", "right", "both"):
             raise ParameterError("support", support, "'left', 'right' or 'both'")
@@ -318,16 +343,36 @@ class WholeBodyIK:
         self.solver.dt = dt
         self._set_targets(com_xy, left_sole, right_sole, upper_body_offsets)
         previous = np.array(self.robot.state.q, dtype=float)
+        self.damping_task.set_joints(
+            {name: self.robot.get_joint(name) for name in self.joint_names}
+        )
+        self.damping_task.configure("damping", "soft", DAMPING_GAIN * self._residual)
         try:
             self.solver.solve(True)
-        except RuntimeError as error:  # placo's QP: the hard tasks cannot all hold
+        except RuntimeError as error:  # placo's QP: no motion within the limits, or NaN
             self.robot.state.q = previous
             self.robot.update_kinematics()
             raise IkInfeasibleError(support, np.asarray(com_xy, float), str(error)) from error
         self.robot.update_kinematics()
+        self._residual = self.task_error(left_sole, right_sole, support)
         velocity = pinocchio.difference(self.robot.model, previous, self.robot.state.q) / dt
         self.angular_momentum = (np.asarray(self.robot.centroidal_map()) @ velocity)[3:6]
         return self.joint_angles()
+
+    def task_error(
+        self, left_sole: NDArray[np.float64], right_sole: NDArray[np.float64], support: Support
+    ) -> float:
+        """Weighted squared error of the feet's and the CoM's tasks at the present
+        configuration, as the QP weighs them [-]."""
+        error = COM_WEIGHT * float(np.sum((self.com_world() - self.com_task.target_world) ** 2))
+        for foot, target in (("left", left_sole), ("right", right_sole)):
+            weight = STANCE_WEIGHT if support in (foot, "both") else FOOT_WEIGHT
+            pose = self.sole_world(foot)
+            rotation = pinocchio.log3(target[:3, :3].T @ pose[:3, :3])
+            error += weight * float(
+                np.sum((pose[:3, 3] - target[:3, 3]) ** 2) + np.sum(rotation**2)
+            )
+        return error
 
     def joint_angles(self) -> NDArray[np.float64]:
         """Current IK joint angles [rad] in :attr:`joint_names` order."""

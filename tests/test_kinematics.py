@@ -286,3 +286,29 @@ def test_g1s_flywheel_joints_are_not_held():
     description = get_robot("g1")
     assert WholeBodyIK(description, upper_body=True).held_joints == []
     assert set(WholeBodyIK(description).held_joints) == set(description.upper_body_joints)
+
+
+@pytest.mark.parametrize("robot", ["g1", "talos"])
+def test_beyond_the_legs_reach_the_ik_gives_the_nearest_stance_without_jumps(robot):
+    """Soles spread 1 cm per 10 ms tick from the nominal stance to 15 cm past the legs'
+    reach, then held there: the IK (damped as Levenberg-Marquardt's) moves no joint target
+    more than 0.25 rad in a tick, settles (the last 10 ticks under 0.02 rad each), and
+    leaves each sole no further from its target than the stance is beyond the reach, plus 1
+    cm. With the stance soles as hard tasks the QP had no solution 1.5 cm past G1's
+    reach; soft but undamped, G1's joint targets jumped by 4.5 rad in a tick."""
+    description = get_robot(robot)
+    reach = lateral_reach(description)
+    ik = WholeBodyIK(description, upper_body=bool(description.upper_body_joints))
+    ik.reset(*stance(description.foot_spacing), np.zeros(2))
+    solutions = [ik.joint_angles()]
+    widest = reach + 0.15
+    for i in range(int(round((widest - description.foot_spacing) / 0.01)) + 30):
+        width = min(description.foot_spacing + 0.01 * i, widest)
+        targets = stance(width)
+        solutions.append(ik.solve(np.zeros(2), *targets, "both", DT))
+    steps = np.abs(np.diff(np.array(solutions), axis=0)).max(axis=1)
+    assert steps.max() <= 0.25, (robot, steps.max())
+    assert steps[-10:].max() <= 0.02, (robot, steps[-10:])
+    for foot, target in zip(("left", "right"), targets, strict=True):
+        error = np.linalg.norm(ik.sole_world(foot)[:3, 3] - target[:3, 3])
+        assert error <= (widest - reach) + 0.01, (robot, foot, error)

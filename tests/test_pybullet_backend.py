@@ -183,14 +183,38 @@ def test_swing_foot_lands_on_a_target_moved_during_the_swing(backend):
     assert not backend.fall_status().fell
 
 
-def test_an_unreachable_stance_foot_is_a_fall_not_a_crash(backend):
-    """Feet 1.5 m apart in double support make placo's QP infeasible: the backend
-    holds its joint targets and reports a fall with the reason."""
+def test_an_unreachable_stance_foot_is_reached_for_not_a_failure(backend):
+    """Feet 1.5 m apart in double support are far out of the legs' reach: the IK, its
+    tasks soft, commands a posture towards them, every joint target finite and within its
+    limits, and nothing is reported as failed (with the support soles as hard tasks
+    placo's QP had no solution)."""
     backend.reset(STANDING)
+    ik = backend.controller.ik
     far = Foothold("left", np.array([1.5, 0.1]))
     backend.step(command(0.0, np.zeros(2), stance=far, since_step=0.0), np.zeros(2))
+    angles = ik.joint_angles()
+    assert np.all(np.isfinite(angles))
+    for name, angle in zip(ik.joint_names, angles, strict=True):
+        lower, upper = ik.robot.get_joint_limits(name)
+        assert lower - 1e-9 <= angle <= upper + 1e-9, (name, angle)
+    assert backend.controller.failure is None
+    backend.reset(STANDING)
+
+
+def test_an_ik_without_solution_is_a_fall_not_a_crash(backend, monkeypatch):
+    """If placo's QP has no solution (seen only with hard tasks, which the IK no longer
+    has), the backend holds its joint targets and reports a fall with the reason."""
+    from kinematics.whole_body_ik import IkInfeasibleError
+
+    def no_solution(*args, **kwargs):
+        raise IkInfeasibleError("both", np.zeros(2), "Infeasible QP")
+
+    backend.reset(STANDING)
+    monkeypatch.setattr(backend.controller.ik, "solve", no_solution)
+    backend.step(command(0.0, np.zeros(2)), np.zeros(2))
     status = backend.fall_status()
-    assert status.fell and "IK infeasible" in status.reason
+    assert status.fell and "IK infeasible" in status.reason, status
+    monkeypatch.undo()
     backend.reset(STANDING)
     assert not backend.fall_status().fell
 
@@ -214,23 +238,20 @@ def test_a_wrench_distribution_without_solution_is_a_fall_not_a_crash(backend, m
     assert not backend.fall_status().fell
 
 
-def test_ik_infeasibility_is_a_project_error_with_its_data():
+def test_a_failed_ik_solve_is_a_project_error_with_its_data():
+    """placo's QP without an answer (here for a NaN CoM target: its tasks are soft, so
+    targets out of reach have one) is an IkInfeasibleError carrying the support and the
+    target, and the IK's configuration is left as it was."""
     from kinematics.whole_body_ik import IkInfeasibleError, WholeBodyIK, sole_pose
 
     ik = WholeBodyIK(get_robot("g1"))
-    ik.reset(
-        sole_pose(np.array([0.0, 0.1, 0.0])), sole_pose(np.array([0.0, -0.1, 0.0])), np.zeros(2)
-    )
+    left, right = sole_pose(np.array([0.0, 0.1, 0.0])), sole_pose(np.array([0.0, -0.1, 0.0]))
+    ik.reset(left, right, np.zeros(2))
     before = ik.joint_angles()
     with pytest.raises(IkInfeasibleError) as caught:
-        ik.solve(
-            np.zeros(2),
-            sole_pose(np.array([1.0, 0.1, 0.0])),
-            sole_pose(np.array([-1.0, -0.1, 0.0])),
-            "both",
-            0.01,
-        )
+        ik.solve(np.array([np.nan, 0.0]), left, right, "both", 0.01)
     assert caught.value.support == "both"
+    assert np.isnan(caught.value.com_target[0])
     np.testing.assert_array_equal(ik.joint_angles(), before)
 
 

@@ -237,6 +237,39 @@ def test_after_a_backward_push_at_mid_swing_the_soles_land_on_their_footholds():
     assert len(later) >= 3 and max(later) < 0.015, errors
 
 
+def test_at_the_legs_reach_the_ik_holds_its_soles_and_moves_its_joints_smoothly():
+    """27.6 N s to the left and slightly back (112.5 deg) at 2.9 s, late in the right
+    foot's single support: the left foot steps out 0.55 m, the legs' reach, and the real
+    stance sole slips outwards. Through the catch and the steps after it the IK moves no
+    joint target more than 0.25 rad from one tick to the next and a support sole it stands
+    on by no more than 1.5 cm, and G1 recovers. With the support soles as hard tasks,
+    placo's step at the reach left them up to 37 cm off their targets and moved joint targets
+    by up to 92 deg in a tick; G1 jumped off the ground and fell (measured)."""
+    push = Push(2.9, np.array([-10.543692230395413, 25.454724780108435]), 0.1)
+    previous: dict[str, Any] = {}
+    worst = {"joint": 0.0, "sole": 0.0}
+
+    def observe(out: PlannerOutput, backend: Any) -> None:
+        ik = backend.controller.ik
+        angles = ik.joint_angles()
+        support = ("left", "right") if out.double_support else (out.stance.foot,)
+        soles = {foot: ik.sole_world(foot)[:3, 3].copy() for foot in ("left", "right")}
+        if out.time > push.time and "angles" in previous:
+            worst["joint"] = max(worst["joint"], float(np.abs(angles - previous["angles"]).max()))
+            for foot in support:
+                if foot in previous["support"]:
+                    moved = float(np.linalg.norm(soles[foot] - previous["soles"][foot]))
+                    worst["sole"] = max(worst["sole"], moved)
+        previous.update(angles=angles, support=support, soles=soles)
+
+    result, _ = run_g1(
+        Scenario("push", push.time + 4.0, (push,), reference_mass=None), observe=observe
+    )
+    assert result.recovered, result.fall.reason
+    assert worst["joint"] <= 0.25, worst
+    assert worst["sole"] <= 0.015, worst
+
+
 def test_a_sole_landing_before_its_timing_jump_is_stepped_on_at_once():
     """20 N s forward and to the left as the double support begins (2.3 s): the
     planner brings the left foot's step forward to 2.65 s, the earliest a swing may

@@ -4,8 +4,9 @@
 
 * measure: the state estimate (:mod:`.estimator`) from the measurement record;
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
-  the swing sole's IK target is corrected for the real body's tilt on its stance ankle
-  (:meth:`WholeBodyController._swing_correction`);
+  the swing sole's IK target is corrected for the real body's tilt on its stance ankle,
+  and the new stance sole's is continuous at a step
+  (:meth:`WholeBodyController._ik_sole_offsets`);
 * stabilize: the pivot the planner commands, the CoP and net force that realise it and
   hold the CoM at the height the IK will be asked for (:mod:`.centroidal`), shared among
   the feet on the ground, each foot's CoP on its sole at the force it carries
@@ -145,6 +146,8 @@ class WholeBodyController:
         self._motion_momentum_rate = np.zeros(2)
         self._stance_yaw = 0.0  # [rad] the stance sole's yaw when it landed
         self._swing_error = np.zeros(2)  # [m] see _swing_correction
+        self._landing_offset = np.zeros(2)  # [m] see _ik_sole_offsets
+        self._ik_soles: dict[Foot, NDArray[np.float64]] = {}  # [m] x, y the IK was given
         self._swing_start_yaw = 0.0  # [rad] the swing sole's yaw when it lifted off
         self.planned_cop = np.array(com_xy, dtype=float)
         self.planned_forces: dict[Foot, float] = {}
@@ -185,7 +188,7 @@ class WholeBodyController:
         swing: Foot = other_foot(stance)
         state = self._estimate(measurement, command)  # measure
         if stance != self._stance:  # the planner stepped: the old stance foot lifts off
-            self._start_swing(stance, swing)
+            self._start_swing(command, stance, swing)
         # swing foot
         soles = self._sole_targets(command, stance, swing)
         self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
@@ -209,9 +212,11 @@ class WholeBodyController:
         com_target, _ = integrate_lipm(
             self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
         )
-        # IK, the swing sole's target corrected for the real body's tilt on its stance ankle
-        soles[swing] = soles[swing].copy()
-        soles[swing][:2, 3] -= self._swing_correction(command, stance, swing)
+        # IK: the soles' targets as the IK is to reach them (the real body's tilt, a step)
+        for foot, offset in self._ik_sole_offsets(command, stance, swing).items():
+            soles[foot] = soles[foot].copy()
+            soles[foot][:2, 3] += offset
+        self._ik_soles = {foot: pose[:2, 3].copy() for foot, pose in soles.items()}
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
         feet, wrenches = self._contact_wrenches(command, measurement, force)
@@ -228,9 +233,18 @@ class WholeBodyController:
         assert self.state is not None  # set by observe()
         return self.state
 
-    def _start_swing(self, stance: Foot, swing: Foot) -> None:
+    def _start_swing(self, command: PlannerOutput, stance: Foot, swing: Foot) -> None:
         self._swing_start_yaw = self._stance_yaw  # the old stance sole's target
-        self.swing.start(self.model.sole_frame(swing)[0][:2])
+        self._swing_error = np.zeros(2)
+        landed = self._ik_soles.get(stance)
+        foothold = np.asarray(command.stance.position, float)
+        self._landing_offset = np.zeros(2) if landed is None else landed - foothold
+        # from where the IK had the old stance sole (its foothold), which it stands on
+        # through the double support: a target moved to the measured sole (up to 2 cm off
+        # its foothold after a slip) is a step the IK's stiffest task takes in one tick
+        previous = self.sole_targets[swing]
+        start = previous if np.all(np.isfinite(previous)) else self.model.sole_frame(swing)[0]
+        self.swing.start(start[:2])
         self.landing.start_swing()
         _, rotation = self.model.sole_frame(stance)
         self._stance_yaw = yaw_of(rotation)
@@ -265,21 +279,39 @@ class WholeBodyController:
         )
         return {stance: sole_pose(foothold, self._stance_yaw), swing: sole_pose(position, yaw)}
 
+    def _ik_sole_offsets(
+        self, command: PlannerOutput, stance: Foot, swing: Foot
+    ) -> dict[Foot, NDArray[np.float64]]:
+        """How far [m] (x, y) the IK's sole targets are from the world's.
+
+        In single support, the swing sole's: minus :meth:`_swing_correction`, so that the
+        real sole lands where the IK puts it relative to the stance sole. In the double
+        support after a step, the new stance sole's: it starts where the IK's swing sole
+        was sent at the step (the correction, and where its trajectory had got to when it
+        touched down) and reaches its foothold by the end of the double support, as its
+        height does (:class:`app.stabilizer.landing.Landing`). From the step on the IK
+        stands on it, and a target that jumped to the foothold in one tick (up to 13 cm
+        after an early touchdown) is a jump of the legs' joints
+        (docs/notes/2026-12-07-ik-at-the-legs-reach.md).
+        """
+        if command.double_support:
+            settle = self.timing.double_support
+            elapsed = command.time_since_step + self.period
+            remaining = max(0.0, 1.0 - elapsed / settle) if settle > 0.0 else 0.0
+            return {stance: self._landing_offset * remaining}
+        return {swing: -self._swing_correction(command, stance, swing)}
+
     def _swing_correction(
         self, command: PlannerOutput, stance: Foot, swing: Foot
     ) -> NDArray[np.float64]:
-        """How far [m] (x, y) the swing sole's IK target is moved so that the real sole lands
-        where the IK puts it relative to the stance sole: zero in the double support; in
-        single support the low-passed offset, relative to the measured stance sole, of the
-        real swing sole with the swing leg at the IK's angles (the body's tilt on its
-        stance ankle, which the IK's body does not have; the swing leg's own lag is the
-        feed-forward's) from the IK's, less the part that lengthens the step (a body leaning
-        into a push carries its swing sole further that way, which the planner's step does
-        not include and the recovery needs; docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md).
+        """How far [m] (x, y) the swing sole's IK target is moved in single support: the
+        low-passed offset, relative to the measured stance sole, of the real swing sole
+        with the swing leg at the IK's angles (the body's tilt on its stance ankle, which
+        the IK's body does not have; the swing leg's own lag is the feed-forward's) from
+        the IK's, less the part that lengthens the step (a body leaning into a push carries
+        its swing sole further that way, which the planner's step does not include and the
+        recovery needs; docs/notes/2026-12-07-swing-sole-on-a-tilted-body.md).
         """
-        if command.double_support:
-            self._swing_error = np.zeros(2)
-            return self._swing_error
         q = self.model.q.copy()
         leg = self._legs[swing]
         q[7 + leg] = self._targets[0][leg]
@@ -316,7 +348,7 @@ class WholeBodyController:
                 com_target, soles["left"], soles["right"], support, dt, upper_body_offsets=offsets
             )[self._ik_order]
         except IkInfeasibleError as error:
-            # Seen only while falling: hold the last targets and report the fall.
+            # Not seen since the IK's tasks are soft: hold the last targets, report a fall.
             self.failure = f"whole-body IK infeasible at t = {command.time:.2f} s ({error.reason})"
             q = self._targets[0]
         momentum = self.ik.angular_momentum[:2].copy()
