@@ -174,6 +174,8 @@ class WholeBodyIK:
         self.description = description
         self.robot = humanoid_robot(description)
         self.joint_names: list[str] = list(self.robot.joint_names())
+        model = self.robot.model  # each joint's angle in the configuration vector
+        self._q_index = np.array([model.idx_qs[model.getJointId(n)] for n in self.joint_names])
         unknown = set(description.standing_posture) - set(self.joint_names)
         if unknown:
             raise ParameterError("standing_posture", sorted(unknown), "joints of the URDF")
@@ -239,7 +241,7 @@ class WholeBodyIK:
         if support == self._support:
             return
         for foot, task in self.foot_tasks.items():
-            weight = STANCE_WEIGHT if support in (foot, "both") else FOOT_WEIGHT
+            weight = _foot_weight(foot, support)
             task.configure(f"{foot}_foot", "soft", weight, weight)
         self._support = support
 
@@ -343,9 +345,7 @@ class WholeBodyIK:
         self.solver.dt = dt
         self._set_targets(com_xy, left_sole, right_sole, upper_body_offsets)
         previous = np.array(self.robot.state.q, dtype=float)
-        self.damping_task.set_joints(
-            {name: self.robot.get_joint(name) for name in self.joint_names}
-        )
+        self.damping_task.set_joints(dict(zip(self.joint_names, self.joint_angles(), strict=True)))
         self.damping_task.configure("damping", "soft", DAMPING_GAIN * self._residual)
         try:
             self.solver.solve(True)
@@ -366,7 +366,7 @@ class WholeBodyIK:
         configuration, as the QP weighs them [-]."""
         error = COM_WEIGHT * float(np.sum((self.com_world() - self.com_task.target_world) ** 2))
         for foot, target in (("left", left_sole), ("right", right_sole)):
-            weight = STANCE_WEIGHT if support in (foot, "both") else FOOT_WEIGHT
+            weight = _foot_weight(foot, support)
             pose = self.sole_world(foot)
             rotation = pinocchio.log3(target[:3, :3].T @ pose[:3, :3])
             error += weight * float(
@@ -376,7 +376,7 @@ class WholeBodyIK:
 
     def joint_angles(self) -> NDArray[np.float64]:
         """Current IK joint angles [rad] in :attr:`joint_names` order."""
-        return np.array([self.robot.get_joint(name) for name in self.joint_names])
+        return np.asarray(self.robot.state.q, dtype=float)[self._q_index]
 
     def com_world(self) -> NDArray[np.float64]:
         """CoM of the IK model in the world [m], shape (3,)."""
@@ -385,6 +385,11 @@ class WholeBodyIK:
     def sole_world(self, foot: str) -> NDArray[np.float64]:
         """Pose 4x4 of the IK model's ``foot`` sole in the world [m]."""
         return np.asarray(self.robot.get_T_world_frame(FOOT_FRAMES[foot]), dtype=float)
+
+
+def _foot_weight(foot: str, support: Support) -> float:
+    """The weight [-] of ``foot``'s task when the IK stands on ``support``."""
+    return STANCE_WEIGHT if support in (foot, "both") else FOOT_WEIGHT
 
 
 def _mean_yaw(left_sole: NDArray[np.float64], right_sole: NDArray[np.float64]) -> float:

@@ -242,9 +242,8 @@ class WholeBodyController:
         # from where the IK had the old stance sole (its foothold), which it stands on
         # through the double support: a target moved to the measured sole (up to 2 cm off
         # its foothold after a slip) is a step the IK's stiffest task takes in one tick
-        previous = self.sole_targets[swing]
-        start = previous if np.all(np.isfinite(previous)) else self.model.sole_frame(swing)[0]
-        self.swing.start(start[:2])
+        previous = self._ik_soles.get(swing)
+        self.swing.start(self.model.sole_frame(swing)[0][:2] if previous is None else previous)
         self.landing.start_swing()
         _, rotation = self.model.sole_frame(stance)
         self._stance_yaw = yaw_of(rotation)
@@ -295,10 +294,8 @@ class WholeBodyController:
         (docs/notes/2026-12-07-ik-at-the-legs-reach.md).
         """
         if command.double_support:
-            settle = self.timing.double_support
-            elapsed = command.time_since_step + self.period
-            remaining = max(0.0, 1.0 - elapsed / settle) if settle > 0.0 else 0.0
-            return {stance: self._landing_offset * remaining}
+            settling = self.landing.settling(command.time_since_step + self.period)
+            return {stance: self._landing_offset * settling}
         return {swing: -self._swing_correction(command, stance, swing)}
 
     def _swing_correction(

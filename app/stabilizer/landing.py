@@ -60,5 +60,12 @@ class Landing:
 
     def stance_height(self, time_since_step: float) -> float:
         """Target height [m] of the new stance sole in the double support after a step."""
-        remaining = max(0.0, 1.0 - time_since_step / self.double_support)
-        return self._last_height * remaining
+        return self._last_height * self.settling(time_since_step)
+
+    def settling(self, time_since_step: float) -> float:
+        """Share [-] of its way to the ground (and, in the controller, to its foothold) that
+        the new stance sole's target still has to go: 1 at the step, 0 from the end of the
+        double support on."""
+        if self.double_support <= 0.0:
+            return 0.0
+        return max(0.0, 1.0 - time_since_step / self.double_support)
