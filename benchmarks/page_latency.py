@@ -1,19 +1,25 @@
-"""Click-to-applied latency of the demo page in headless Chromium without GPU.
+"""Click-to-screen latency of the demo page in headless Chromium (software WebGL).
 
-Starts ``rsg demo`` (this checkout), opens the page in Debian's Chromium with software
-WebGL, waits for the robot to render, then clicks Push several times, as a user does
-(a mouse click at the button, not Playwright's ``locator.click``, which first waits for
-the button to be still over two animation frames, several seconds here), and measures
-the wall time from the click to the simulation's ``push t=`` line. Also measures the
-page's animation-frame rate (software WebGL draws the G1 at about one frame per
-second). Prints one line. Needs /usr/bin/chromium and the ``playwright`` package.
+Starts ``rsg demo`` (this checkout), opens the page in Debian's Chromium and clicks
+Push several times, as a user does (a mouse click at the button). A probe injected
+into the page records, on the page's own clock, the click (``pointerdown``) and the
+end of every animation frame in which the page applied a scene frame; each scene
+frame carries a token with the number of pushes it shows (``web.client_view``), so
+the first frame that shows a push is known. Click-to-screen is the time from the
+click to the end of that frame. Also reported: the tab's drawn frame rate and the
+time from the click to the simulation's ``push t=`` line (click-to-applied).
 
-    python benchmarks/page_latency.py --model pybullet --frame-rate 40 --pushes 5
+Two renderers, both software (this machine has no GPU): ``slow`` is a 1280 x 800
+window, ``fast`` a 480 x 300 one (a fifth of the pixels to shade). Needs
+/usr/bin/chromium and the ``playwright`` package.
+
+    python benchmarks/page_latency.py --model pybullet --renderer slow --pushes 5
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import socket
 import statistics
@@ -28,50 +34,66 @@ ROOT = Path(__file__).resolve().parents[1]
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
          "--disable-background-networking", "--disable-component-update",
          "--disable-sync"]  # fmt: skip
-APPLIED = ("push ",)  # the simulation's line for a push request (applied, refused, ignored)
-TIMEOUT = 180.0  # [s] a click not answered by then counts as this
+VIEWPORTS = {"slow": (1280, 800), "fast": (480, 300)}
+TIMEOUT = 60.0  # [s] a push not on screen by then counts as this
+
+# Records frame tokens (key -> request uuid) arriving from viser's websocket worker,
+# the answers the page sends back while it applies a frame, and the end of that
+# animation frame; and every click.
+PROBE = """
+(() => {
+  const keys = {}; window.__rsgFrames = []; window.__rsgClicks = [];
+  let applied = null;
+  const Original = window.Worker;
+  window.Worker = class extends Original {
+    constructor(...args) {
+      super(...args);
+      const post = this.postMessage.bind(this);
+      this.postMessage = (data, transfer) => {
+        const m = data && data.message;
+        if (data && data.type === "send" && m && m.type === "LocalStorageGetItemResponseMessage")
+          applied = keys[m.request_uuid];
+        return transfer === undefined ? post(data) : post(data, transfer);
+      };
+      const setter = Object.getOwnPropertyDescriptor(Original.prototype, "onmessage").set;
+      Object.defineProperty(this, "onmessage", { set(handler) {
+        setter.call(this, (event) => {
+          const d = event.data;
+          if (d && d.type === "message_batch")
+            for (const m of d.messages)
+              if (m.type === "LocalStorageGetItemRequestMessage") keys[m.request_uuid] = m.key;
+          handler(event);
+        });
+      } });
+    }
+  };
+  const raf = window.requestAnimationFrame.bind(window);
+  window.requestAnimationFrame = (callback) => raf((stamp) => {
+    callback(stamp);
+    if (applied !== null) {
+      window.__rsgFrames.push([applied, performance.now()]); applied = null;
+    }
+  });
+  window.addEventListener("pointerdown", () => window.__rsgClicks.push(performance.now()), true);
+})();
+"""
 
 
-FRAME_RATE_JS = """() => new Promise(done => {
-  let frames = 0; const start = performance.now();
-  function frame() {
-    frames++;
-    if (performance.now() - start < 5000) requestAnimationFrame(frame);
-    else done(frames / ((performance.now() - start) / 1000));
-  }
-  requestAnimationFrame(frame);
-})"""
+def pushes_of(key: str | None) -> int:
+    """The push count a frame token's key carries (rsg-frame:<serial>:<pushes>)."""
+    if not key or not key.startswith("rsg-frame:"):
+        return -1
+    return int(key.rsplit(":", 1)[1])
 
 
-def wait_for_line(
-    page, locator, lines: list[tuple[float, str]], prefixes: tuple[str, ...]
-) -> float:
-    """Seconds from a mouse click at the centre of ``locator``, as a user clicks, to the
-    first new line starting with one of ``prefixes``. (Where the button is, is read
-    before: reading it waits for the page's busy main thread too.)"""
-    box = locator.bounding_box()
-    before = len(lines)
-    clicked = time.perf_counter()
-    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
-    while time.perf_counter() - clicked < TIMEOUT:
-        found = next((t for t, line in lines[before:] if line.startswith(prefixes)), None)
-        if found is not None:
-            return found - clicked
-        time.sleep(0.01)
-    return TIMEOUT
-
-
-def measure(
-    model: str, frame_rate: float | None, pushes: int, settle: float
-) -> tuple[list[float], float]:
+def measure(model: str, renderer: str, pushes: int, settle: float) -> dict:
     from playwright.sync_api import sync_playwright
 
     with socket.socket() as probe:
         probe.bind(("127.0.0.1", 0))
         port = probe.getsockname()[1]
-    command = [sys.executable, "-m", "app", "demo", "--model", model, "--port", str(port)]
-    if frame_rate is not None:
-        command += ["--frame-rate", str(frame_rate)]
+    command = [sys.executable, "-m", "app", "demo", "--quiet", "--model", model, "--port",
+               str(port)]  # fmt: skip
     demo = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, text=True, bufsize=1)
     lines: list[tuple[float, str]] = []
     assert demo.stdout is not None
@@ -79,50 +101,78 @@ def measure(
     threading.Thread(
         target=lambda: [lines.append((time.perf_counter(), line)) for line in stdout], daemon=True
     ).start()
-    latencies = []
+    screen, applied, rates = [], [], []
     try:
         while not any("open http" in line for _, line in lines):
             time.sleep(0.2)
+        width, height = VIEWPORTS[renderer]
         with sync_playwright() as api, tempfile.TemporaryDirectory() as profile:
             context = api.chromium.launch_persistent_context(
                 profile, executable_path="/usr/bin/chromium", headless=True, args=FLAGS,
-                viewport={"width": 1280, "height": 800},
+                viewport={"width": width, "height": height},
             )  # fmt: skip
+            context.add_init_script(PROBE)
             page = context.new_page()
             page.set_default_timeout(300_000)
             page.goto(f"http://127.0.0.1:{port}")
             page.get_by_text(re.compile("running")).first.wait_for(state="visible")
             page.wait_for_timeout(settle * 1000)  # meshes load, the page settles
             button = page.get_by_role("button", name="Push", exact=True)
-            reset = page.get_by_role("button", name="Reset", exact=True)
-            frame_rate = page.evaluate(FRAME_RATE_JS)
-            for _ in range(pushes):
-                wait_for_line(page, reset, lines, ("reset",))  # a walking robot to push
-                page.wait_for_timeout(5000)
-                latencies.append(wait_for_line(page, button, lines, APPLIED))
-                page.wait_for_timeout(3000)
+            for number in range(1, pushes + 1):
+                button.scroll_into_view_if_needed()
+                box = button.bounding_box()
+                before = len(lines)
+                clicked = time.perf_counter()
+                page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+                while time.perf_counter() - clicked < TIMEOUT:
+                    frames = page.evaluate("window.__rsgFrames")
+                    if any(pushes_of(key) >= number for key, _ in frames):
+                        break
+                    time.sleep(0.05)
+                click = page.evaluate("window.__rsgClicks")[-1]
+                frames = page.evaluate("window.__rsgFrames")
+                shown = [t for key, t in frames if pushes_of(key) >= number and t >= click]
+                screen.append((min(shown) - click) / 1000.0 if shown else TIMEOUT)
+                found = [t for t, line in lines[before:] if line.startswith("push t=")]
+                applied.append(found[0] - clicked if found else TIMEOUT)
+                recent = [t for _, t in frames if t >= frames[-1][1] - 5000.0]
+                if len(recent) >= 2:
+                    rates.append((len(recent) - 1) / ((recent[-1] - recent[0]) / 1000.0))
+                page.wait_for_timeout(6000)  # the robot recovers before the next push
             context.close()
     finally:
         demo.send_signal(2)
         demo.wait(30)
-    return latencies, frame_rate
+    return {
+        "model": model,
+        "renderer": renderer,
+        "viewport": list(VIEWPORTS[renderer]),
+        "frames_per_s": statistics.median(rates) if rates else 0.0,
+        "click_to_screen_s": screen,
+        "click_to_applied_s": applied,
+    }
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--model", choices=("lipm", "pybullet"), default="pybullet")
-    parser.add_argument("--frame-rate", type=float, default=None, help="default: the demo's")
+    parser.add_argument("--renderer", choices=tuple(VIEWPORTS), default="slow")
     parser.add_argument("--pushes", type=int, default=5)
     parser.add_argument("--settle", type=float, default=40.0, help="wait after load [s]")
+    parser.add_argument("--out", type=Path, default=None, help="also write the figures here")
     args = parser.parse_args()
-    latencies, browser_rate = measure(args.model, args.frame_rate, args.pushes, args.settle)
-    shown = "default" if args.frame_rate is None else f"{args.frame_rate:g} Hz"
+    result = measure(args.model, args.renderer, args.pushes, args.settle)
+    screen, applied = result["click_to_screen_s"], result["click_to_applied_s"]
     print(
-        f"{args.model} page rate {shown}, browser {browser_rate:.2f} frames/s: click-to-applied "
-        f"median "
-        f"{statistics.median(latencies):.2f} s, max {max(latencies):.2f} s over {len(latencies)} "
-        f"pushes ({', '.join(f'{v:.2f}' for v in latencies)})"
+        f"{args.model}, {args.renderer} renderer {result['viewport'][0]}x"
+        f"{result['viewport'][1]}, tab draws {result['frames_per_s']:.1f} frames/s: "
+        f"click-to-screen median {statistics.median(screen):.2f} s, max {max(screen):.2f} s; "
+        f"click-to-applied median {statistics.median(applied):.2f} s over {len(screen)} pushes "
+        f"({', '.join(f'{v:.2f}' for v in screen)})"
     )
+    if args.out is not None:
+        args.out.parent.mkdir(parents=True, exist_ok=True)
+        args.out.write_text(json.dumps(result, indent=2))
 
 
 if __name__ == "__main__":

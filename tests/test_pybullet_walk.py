@@ -107,6 +107,14 @@ def test_g1_walks_20_s_on_leg_odometry_and_lands_where_planned():
     assert result.recovered
 
 
+def test_g1_walks_past_x_100_m_where_pybullets_plane_ended():
+    """PyBullet's plane.urdf ends at x = 100 m; at 0.3 m a step G1 is there after 264 s."""
+    result, _ = run_g1(BUILT_IN["walk"], duration=290.0, overrides=(("stride_length", "0.3"),))
+    assert not result.fall.fell, result.fall.reason
+    assert result.sim_time == pytest.approx(290.0)
+    assert result.column("com_x")[-1] > 103.0
+
+
 def test_talos_walks_10_s_with_the_rsg_and_lands_where_planned():
     """The second robot: only its description (robots/talos.py), no controller change."""
     result, errors = run_g1(BUILT_IN["walk"], duration=10.0, robot="talos")

@@ -49,6 +49,18 @@ PUSH_LINE = re.compile(r"^push t=(\d+\.\d+) s impulse=\((-?\d+\.\d+), (-?\d+\.\d
 ADJUSTED_LINE = re.compile(r"^step t=(\d+\.\d+) s foot=(left|right) .* adjusted=yes")
 GROUND_TOLERANCE = 4  # [px] ~1.5 cm at the side view's distance
 PANEL_LEFT = 860  # [px] the GUI panel covers the canvas right of this (1280 px wide)
+# (field, text typed, what the refusal starts with) for the LIPM's 60 kg: each refused.
+BAD_PUSHES = (
+    ("Impulse [N s]", "", "impulse is empty"),
+    ("Impulse [N s]", "NaN", "impulse 'NaN' is not a number"),
+    ("Impulse [N s]", "abc", "impulse 'abc' is not a number"),
+    ("Impulse [N s]", "1e9", "impulse 1e9 N s is out of range: allowed more than 0 to 30 N s"),
+    ("Impulse [N s]", "0", "impulse 0 N s is out of range"),
+    ("Direction [deg]", "1e9", "direction 1e9 deg is out of range: allowed from -360 to 360"),
+    ("Direction [deg]", "720.5", "direction 720.5 deg is out of range"),
+    ("Direction [deg]", "", "direction is empty"),
+    ("Duration [s]", "5", "duration 5 s is out of range: allowed from 0.05 to 0.5 s"),
+)
 
 
 class ServerProcess:
@@ -285,23 +297,38 @@ def test_lipm_page_push_fields_aim_pause_and_reset(playwright_api, serve):
             wait_for_status(page, r"t = \d+\.\d+ s")
             wait_for_status(page, "running")
             page.wait_for_timeout(3000)
-            # Fields: what is typed is read once the user stops typing; the field then
-            # shows the value that will be used, and bad text is refused visibly.
+            # Fields: Push reads what they hold at that moment; a bad value is refused
+            # at once, on the page and in the log, the field left as typed, nothing pushed.
+            start = len(demo.lines)
+            for label, bad, says in BAD_PUSHES:
+                box = field(page, label)
+                good = box.input_value()
+                box.fill(bad)
+                before = len(demo.lines)
+                click(page, button(page, "Push"))
+                index, _ = demo.wait_for_line(r"^push refused: ", timeout=30, start=before)
+                assert demo.lines[index].startswith(f"push refused: {says}"), demo.lines[index]
+                wait_for_status(page, "push refused: " + re.escape(says), timeout_ms=30_000)
+                assert box.input_value() == bad  # never rewritten by the page
+                box.fill(good)
+            assert not any(line.startswith("push t=") for line in demo.lines[start:])
+            # Typed key by key on a slow page: the field is not rewritten while typing,
+            # and the push is the value typed, exactly.
             impulse = field(page, "Impulse [N s]")
-            used = impulse.input_value()
             impulse.fill("")
-            wait_for_value(page, "Impulse [N s]", used)
-            wait_for_status(page, r"impulse: empty; using " + re.escape(used) + " N s")
-            direction = field(page, "Direction [deg]")
-            direction.fill("720")
-            wait_for_value(page, "Direction [deg]", "0")
-            impulse.fill("0")
+            impulse.press_sequentially("5.557", delay=700)
             page.wait_for_timeout(3000)
+            assert impulse.input_value() == "5.557"
             before = len(demo.lines)
             click(page, button(page, "Push"))
-            demo.wait_for_line(r"^push refused: impulse 0 N s", timeout=30, start=before)
-            assert not any(line.startswith("push t=") for line in demo.lines[before:])
+            _, push = demo.wait_for_line(PUSH_LINE, timeout=30, start=before)
+            assert np.hypot(float(push.group(2)), float(push.group(3))) == pytest.approx(
+                5.557, abs=0.01
+            )
+            wait_for_status(page, "pushed 5.557 N s")
+            page.wait_for_timeout(4000)  # the LIPM recovers before the paper's push
             # The paper's first push, typed in: applied, followed by an adjusted step.
+            direction = field(page, "Direction [deg]")
             direction.fill("-36.87")
             impulse.fill("10")
             page.wait_for_timeout(3000)

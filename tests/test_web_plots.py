@@ -77,3 +77,27 @@ def test_axis_steps_and_the_log_axis_of_v_u():
 @pytest.mark.parametrize("value", [0.0, -1.0, float("nan")])
 def test_nice_ceiling_of_nothing_is_one(value):
     assert nice_ceiling(value) == 1.0
+
+
+def test_the_log_axis_stays_readable_after_a_fall():
+    """After a fall V_u grows without bound: the ratio and the axis stop at 10^4."""
+    from web.plots import RATIO_CEILING
+
+    ratio = lyapunov_ratio(np.array([1e-9, 3.0, 1e12, np.nan]), 1.0)
+    assert ratio.max() == RATIO_CEILING == log_axis_top(1e12)
+    np.testing.assert_allclose(ratio[:2], [1e-3, 3.0])
+
+
+def test_the_inset_keeps_the_threshold_level_set_readable_after_a_large_push():
+    from web.plots import INSET_ZOOM, DcmErrorPlot
+
+    plot = DcmErrorPlot()
+    angles = np.linspace(0.0, 2.0 * np.pi, 50)
+    circle = 0.01 * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    plot.render(np.zeros(2), np.zeros((0, 2)), circle, circle, False)
+    assert plot.inset_half_range == 0.0 and not plot.inset.get_visible()  # small axes
+    trail = np.array([[0.0, 0.0], [0.3, -0.2]])
+    plot.render(trail[-1], trail, circle, 30.0 * circle, True)
+    assert plot.half_range > INSET_ZOOM * plot.inset_half_range > 0.0
+    assert plot.inset.get_visible()
+    assert plot.inset.get_xlim()[1] >= 0.01  # the whole gamma_v level set is inside

@@ -1,50 +1,78 @@
-"""The push fields: what the user types becomes the value used, shown in the field."""
+"""The push fields: Push applies exactly what they hold, or refuses and says why."""
 
 from __future__ import annotations
 
 import math
 
-import numpy as np
 import pytest
 
 from web.push_input import (
     PushBounds,
     PushInput,
+    field_rules,
     format_field,
     push_refusal,
-    read_field,
+    read_push,
     wrap_degrees,
 )
 
 BOUNDS = PushBounds.for_mass(33.3)
-
-
-def clip_impulse(value: float) -> float:
-    return float(np.clip(value, 0.0, BOUNDS.impulse_max))
+GOOD = {"direction": "30", "impulse": "5.557", "duration": "0.1"}
 
 
 @pytest.mark.parametrize(
-    "text,value,shown",
-    [("720", 0.0, "0"), ("-180", 180.0, "180"), (" 45.5 ", 45.5, "45.5"), ("-405", -45.0, "-45"),
-     ("1e1", 10.0, "10"), ("190", -170.0, "-170")],
+    "text,value",
+    [("-180", 180.0), (" 45.5 ", 45.5), ("-36.87", -36.87), ("1e1", 10.0),
+     ("190", -170.0), ("360", 0.0), ("-360", 0.0)],
 )  # fmt: skip
-def test_direction_field_wraps_and_shows_the_value_used(text, value, shown):
-    read = read_field(text, 30.0, "direction", "deg", wrap_degrees)
-    assert read.value == pytest.approx(value) and read.text == shown and read.refused == ""
+def test_a_direction_in_the_pages_range_is_wrapped_as_its_hint_says(text, value):
+    push = read_push({**GOOD, "direction": text}, BOUNDS)
+    assert isinstance(push, PushInput)
+    assert push.direction == pytest.approx(value)
 
 
-@pytest.mark.parametrize("text", ["", "   ", "abc", "1,5", "nan", "inf", "-", "1e"])
-def test_empty_or_non_numeric_text_is_refused_and_the_field_shows_the_value_in_use(text):
-    read = read_field(text, 5.6, "impulse", "N s", clip_impulse)
-    assert read.value == 5.6 and read.text == "5.6"
-    assert read.refused.startswith("impulse: ") and read.refused.endswith("using 5.6 N s")
-    assert ("empty" in read.refused) == (text.strip() == "")
+def test_the_typed_impulse_and_duration_are_applied_exactly():
+    push = read_push(GOOD, BOUNDS)
+    assert push == PushInput(30.0, 5.557, 0.1)
+    top = read_push({**GOOD, "impulse": repr(BOUNDS.impulse_max)}, BOUNDS)
+    assert isinstance(top, PushInput) and top.impulse == BOUNDS.impulse_max
 
 
-def test_impulse_above_the_bound_is_clipped_and_shown():
-    read = read_field("99", 5.0, "impulse", "N s", clip_impulse)
-    assert read.value == pytest.approx(BOUNDS.impulse_max) == pytest.approx(16.65)
-    assert read.text == format_field(BOUNDS.impulse_max) and read.refused == ""
+@pytest.mark.parametrize(
+    "field,text,says",
+    [("impulse", "", "impulse is empty"), ("impulse", "   ", "impulse is empty"),
+     ("impulse", "abc", "impulse 'abc' is not a number"),
+     ("impulse", "NaN", "impulse 'NaN' is not a number"),
+     ("impulse", "inf", "impulse 'inf' is not a number"),
+     ("impulse", "1,5", "impulse '1,5' is not a number"),
+     ("impulse", "1e9", "impulse 1e9 N s is out of range"),
+     ("impulse", "0", "impulse 0 N s is out of range"),
+     ("impulse", "-3", "impulse -3 N s is out of range"),
+     ("direction", "720.5", "direction 720.5 deg is out of range"),
+     ("direction", "1e9", "direction 1e9 deg is out of range"),
+     ("direction", "", "direction is empty"),
+     ("duration", "5", "duration 5 s is out of range"),
+     ("duration", "0.01", "duration 0.01 s is out of range"),
+     ("duration", "-", "duration '-' is not a number")],
+)  # fmt: skip
+def test_a_bad_field_refuses_the_push_naming_the_field_the_text_and_the_range(field, text, says):
+    refused = read_push({**GOOD, field: text}, BOUNDS)
+    assert isinstance(refused, list) and len(refused) == 1
+    assert refused[0].startswith(says)
+    assert refused[0].endswith(field_rules(BOUNDS)[field].allowed())
+
+
+def test_every_bad_field_is_named_at_once():
+    refused = read_push({"direction": "x", "impulse": "", "duration": "9"}, BOUNDS)
+    assert isinstance(refused, list)
+    assert [r.split()[0] for r in refused] == ["direction", "impulse", "duration"]
+
+
+def test_the_ranges_are_the_robots():
+    rules = field_rules(BOUNDS)
+    assert rules["impulse"].allowed() == f"more than 0 to {format_field(BOUNDS.impulse_max)} N s"
+    assert rules["duration"].allowed() == "from 0.05 to 0.5 s"
+    assert rules["direction"].allowed() == "from -360 to 360 deg"
 
 
 def test_a_zero_impulse_is_refused_as_a_push():

@@ -62,7 +62,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
     push = Push(1.5, np.array([0.0, 4.0]), 0.1)
     loop = ClosedLoop(backend, config, Scenario("walk", 3.0, (push,)), initial)
     world = server.scene.add_frame("/world", show_axes=False, position=WORLD_SHIFT)
-    view = RobotView(server, derived_urdf(backend.description), "/world/robot")
+    view = RobotView(server.scene, derived_urdf(backend.description), "/world/robot")
     assert len(view.joint_names) == 29
     nodes = {"/world": world, **view.nodes}
     ankle_meshes = {

@@ -9,6 +9,7 @@ import argparse
 
 from app.commands.arguments import add_robot_argument
 from planner.parameters import CONTROLLERS
+from web.live import SLOW_MOTION_FACTORS
 
 DEMO_EPILOG = """\
 examples:
@@ -80,9 +81,24 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     add_robot_argument(demo)
     demo.add_argument(
         "--controller",
-        choices=CONTROLLERS,
+        choices=(*CONTROLLERS, "placo-wpg"),
         default="rsg",
-        help="step controller at start; can be changed on the page (default: rsg)",
+        help="step controller at start; can be changed on the page (default: rsg). placo-wpg "
+        "runs headless only (rsg run): it has no DCM-error Lyapunov level for the page to draw",
+    )
+    demo.add_argument(
+        "--speed",
+        type=float,
+        choices=SLOW_MOTION_FACTORS,
+        default=1.0,
+        help="simulated seconds per wall second at start, one of "
+        f"{', '.join(f'{f:g}' for f in SLOW_MOTION_FACTORS)} (default: 1, real time); "
+        "can be changed on the page",
+    )
+    demo.add_argument(
+        "--quiet",
+        action="store_true",
+        help="print no line per step (pushes, refusals, falls, resets and errors still print)",
     )
     demo.add_argument(
         "--scenario",
@@ -112,5 +128,16 @@ def add_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
 def run(args: argparse.Namespace) -> int:
     """Entry-point hook: run ``rsg demo``."""
     from web.demo import main
+
+    if args.controller == "placo-wpg":
+        from planner.exceptions import ParameterError
+
+        raise ParameterError(
+            "--controller",
+            "placo-wpg",
+            f"one of {', '.join(CONTROLLERS)} (placo-wpg has its own preview and IK and no "
+            "DCM-error Lyapunov level for the page; run it headless with rsg run --controller "
+            "placo-wpg and watch it with rsg replay)",
+        )
 
     return int(main(args))

@@ -39,7 +39,14 @@ def main(args: argparse.Namespace) -> int:
     from .demo_page import FRAME_RATE, DemoPage
 
     print(f"rsg demo: building the {args.model} simulation ...", flush=True)
-    live = LiveSimulation(args.model, args.robot, args.controller, args.scenario)
+    live = LiveSimulation(
+        args.model,
+        args.robot,
+        args.controller,
+        args.scenario,
+        log_steps=not getattr(args, "quiet", False),
+        slow_motion=getattr(args, "speed", 1.0),
+    )
     urdf = _robot_urdf(args.model, args.robot)
 
     def start(server: viser.ViserServer):  # noqa: ANN202

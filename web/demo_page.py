@@ -5,14 +5,17 @@ it (:attr:`DemoPage.frame_rate` frames per second while the simulation runs). GU
 callbacks only send requests to the simulation thread, so nothing here waits for
 the simulation. Any browser tab can push, pause or reset the run.
 
-Push fields are text fields (:mod:`web.push_input`): a typed value is read once
-the user has stopped typing for :data:`FIELD_SETTLE_TIME` (or at once when Push
-is pressed); the field then shows the value that will be used (720 deg becomes 0,
-an impulse above the robot's bound the bound), and an empty or non-numeric entry
-is refused: the field shows the value in use again and the page says so. A push
-with a zero impulse, or into a run that is paused, fallen or stopped, is refused
-and not logged as a push. The aim arrow shows for :data:`AIM_TIME` after the user
-changes the push; the push arrow shows while a push acts.
+Push fields are text fields (:mod:`web.push_input`) that the page never rewrites
+while the user types: they are read when Push is pressed, from what they hold at
+that moment. A field that is empty, not a number or out of its range refuses the
+push, on the page (the field, its text, the range allowed) and in the log; nothing
+is clipped. The direction is wrapped to (-180, 180] deg, as its hint says. viser's
+page sends a field's last key and a click at most every 50 ms, keeping only the
+latest, so a Push pressed within :data:`TYPING_GUARD` of the last key received is
+refused too ("press Push again") rather than applied with a text the user did not
+see. A push into a run that is paused, fallen or stopped is refused the same way.
+The aim arrow shows for :data:`AIM_TIME` after the user changes the push; the push
+arrow shows while a push acts (each tab draws it at least once).
 """
 
 from __future__ import annotations
@@ -20,7 +23,6 @@ from __future__ import annotations
 import html
 import time as wallclock
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -33,15 +35,12 @@ from planner.parameters import CONTROLLERS
 from .live import SLOW_MOTION_FACTORS, LiveSimulation
 from .page import PageView
 from .push_input import (
-    FieldValue,
     PushBounds,
     PushInput,
-    clamp_push,
+    field_rules,
     format_field,
     paper_presets,
-    push_refusal,
-    read_field,
-    wrap_degrees,
+    read_push,
 )
 from .scene_model import direction_towards, push_arrow, ray_ground_intersection
 from .snapshot import Snapshot
@@ -50,9 +49,10 @@ from .worker import FrameLoop
 Array = NDArray[np.float64]
 
 FRAME_RATE = 40.0  # [Hz] scene updates while the simulation runs
-FIELD_SETTLE_TIME = 1.5  # [s] a typed field is read once the user stopped typing this long
+TYPING_GUARD = 0.12  # [s] a Push this soon after a field's last key is refused (see above)
 AIM_TIME = 4.0  # [s] the aim arrow shows this long after the push was changed
 CUSTOM = "custom"
+DEFAULT_NOTE = "Click the ground to aim from the robot."
 SLOW_MOTION_LABELS = {
     f"{f:g}x" + (" (real time)" if f == 1.0 else ""): f for f in SLOW_MOTION_FACTORS
 }
@@ -63,6 +63,11 @@ def _set_value(handle: Any, value: object) -> None:
     handle.value = value
 
 
+def _rates(rates: list[float]) -> str:
+    """Each tab's drawn frame rate, e.g. "1.0, 24"."""
+    return ", ".join(f"{r:.1f}" if r < 10.0 else f"{r:.0f}" for r in rates) or "-"
+
+
 def _note_html(text: str, refused: bool = False) -> str:
     """The note under Push: two lines of fixed height (the panel below does not move)."""
     colour = "#c0392b" if refused else "#555555"
@@ -70,19 +75,6 @@ def _note_html(text: str, refused: bool = False) -> str:
         f'<div style="height:2.6em;line-height:1.3em;overflow:hidden;font-size:0.8em;'
         f'color:{colour}">{html.escape(text)}</div>'
     )
-
-
-@dataclass
-class _Field:
-    """A push field: its handle, value in use, and text typed but not read yet."""
-
-    handle: Any
-    name: str
-    unit: str
-    normalise: Callable[[float], float]
-    value: float
-    pending: str | None = None
-    typed_at: float = 0.0
 
 
 class DemoPage(FrameLoop):
@@ -114,13 +106,18 @@ class DemoPage(FrameLoop):
         self._dirty = True
         self._frames: list[float] = []
         self._aim_until = 0.0
-        self._note = ""
+        self._note = ("", False)
         self.update_rate = 0.0  # [Hz] scene updates over the last second
         first = live.snapshot()
         self._bounds = PushBounds.for_mass(first.mass)
         self._presets = paper_presets(first.mass)
-        self.view = PageView(server, urdf, controls=self._build_controls)
+        self.view = PageView(server, urdf, controls=self._build_controls, frame_rate=frame_rate)
         server.scene.on_click()(self._on_click)
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop publishing and every tab's drawing."""
+        super().stop(timeout)
+        self.view.stop()
 
     # ------------------------------------------------------------------------- GUI
     def _build_controls(self) -> None:
@@ -128,116 +125,95 @@ class DemoPage(FrameLoop):
         self.reset_button = gui.add_button("Reset", hint="the robot stands again, the run restarts")
         self.pause_button = gui.add_button("Pause")
         first = next(iter(self._presets.values()))
-        bounds = self._bounds
+        rules = field_rules(self._bounds)
+        self._push = first  # the last push the fields held (drawn as the aim arrow)
         with gui.add_folder("Push"):
             self.preset = gui.add_dropdown("Preset", (*self._presets, CUSTOM), initial_value=CUSTOM)
-            impulse_max = format_field(bounds.impulse_max)
             self.fields = {
-                "direction": _Field(
-                    gui.add_text(
-                        "Direction [deg]",
-                        format_field(first.direction),
-                        hint="0 = forward (+x), 90 = left (+y); any angle, wrapped to "
-                        "(-180, 180]. Or click the ground to aim.",
-                    ),
-                    "direction",
-                    "deg",
-                    wrap_degrees,
-                    first.direction,
+                "direction": gui.add_text(
+                    "Direction [deg]",
+                    format_field(first.direction),
+                    hint="0 = forward (+x), 90 = left (+y); "
+                    f"{rules['direction'].allowed()}, wrapped to (-180, 180]. "
+                    "Or click the ground to aim.",
                 ),
-                "impulse": _Field(
-                    gui.add_text(
-                        "Impulse [N s]",
-                        format_field(first.impulse),
-                        hint=f"more than 0, at most {impulse_max} N s for this robot",
-                    ),
-                    "impulse",
-                    "N s",
-                    lambda v: float(np.clip(v, 0.0, bounds.impulse_max)),
-                    first.impulse,
+                "impulse": gui.add_text(
+                    "Impulse [N s]",
+                    format_field(first.impulse),
+                    hint=f"{rules['impulse'].allowed()} for this robot",
                 ),
-                "duration": _Field(
-                    gui.add_text(
-                        "Duration [s]",
-                        format_field(first.duration),
-                        hint=f"{format_field(bounds.duration_min)} to "
-                        f"{format_field(bounds.duration_max)} s",
-                    ),
-                    "duration",
-                    "s",
-                    lambda v: float(np.clip(v, bounds.duration_min, bounds.duration_max)),
-                    first.duration,
+                "duration": gui.add_text(
+                    "Duration [s]", format_field(first.duration), hint=rules["duration"].allowed()
                 ),
             }
             self.push_button = gui.add_button("Push", color="red")
-            self.push_note = gui.add_html(_note_html("Click the ground to aim from the robot."))
+            self.push_note = gui.add_html(_note_html(DEFAULT_NOTE))
         with gui.add_folder("Simulation", expand_by_default=False):
+            asked = self.live.snapshot().status.slow_motion
             self.slow_motion = gui.add_dropdown(
-                "Slow motion",
+                "Speed",
                 tuple(SLOW_MOTION_LABELS),
-                initial_value=next(iter(SLOW_MOTION_LABELS)),
+                initial_value=next(k for k, v in SLOW_MOTION_LABELS.items() if v == asked),
             )
             self.controller = gui.add_dropdown(
                 "Controller", CONTROLLERS, initial_value=self.live.controller
             )
-        self.push_button.on_click(lambda _: self._push())
-        self.reset_button.on_click(lambda _: self.live.request_reset())
+        self.push_button.on_click(lambda event: self._pressed(event.client))
+        self.reset_button.on_click(lambda _: self._reset())
         self.pause_button.on_click(lambda _: self._toggle_pause())
         self.preset.on_update(lambda _: self._apply_preset())
-        for field in self.fields.values():
-            field.handle.on_update(lambda event, f=field: self._typed(f, event))
+        for handle in self.fields.values():
+            handle.on_update(self._typed)
         self.slow_motion.on_update(
             lambda _: self.live.set_slow_motion(SLOW_MOTION_LABELS[self.slow_motion.value])
         )
         self.controller.on_update(lambda _: self.live.request_controller(self.controller.value))
 
-    def push_input(self) -> PushInput:
-        """The push the fields hold (the values in use), in the safe ranges."""
-        values = {name: field.value for name, field in self.fields.items()}
-        return clamp_push(values["direction"], values["impulse"], values["duration"], self._bounds)
+    def texts(self) -> dict[str, str]:
+        """What the push fields hold now, as the server last received it."""
+        return {name: str(handle.value) for name, handle in self.fields.items()}
 
-    def _typed(self, field: _Field, event: viser.GuiEvent) -> None:
+    def push_input(self) -> PushInput:
+        """The last push the fields held that could be applied (the aim arrow's)."""
+        read = read_push(self.texts(), self._bounds)
+        if isinstance(read, PushInput):
+            self._push = read
+        return self._push
+
+    def _typed(self, event: viser.GuiEvent) -> None:
         if event.client is None:  # set by the page itself
             return
-        field.pending = str(field.handle.value)
-        field.typed_at = wallclock.perf_counter()
         if self.preset.value != CUSTOM:
             _set_value(self.preset, CUSTOM)
+        self._say(DEFAULT_NOTE)
         self._aimed()
 
-    def _settle_fields(self, now: float | None = None) -> list[str]:
-        """Read the fields typed into (all of them if ``now`` is None, else those
-        left alone for :data:`FIELD_SETTLE_TIME`); returns why texts were refused."""
-        refused = []
-        for field in self.fields.values():
-            if field.pending is None:
-                continue
-            if now is not None and now - field.typed_at < FIELD_SETTLE_TIME:
-                continue
-            read: FieldValue = read_field(
-                field.pending, field.value, field.name, field.unit, field.normalise
-            )
-            field.pending = None
-            field.value = read.value
-            if field.handle.value != read.text:
-                _set_value(field.handle, read.text)
-            if read.refused:
-                refused.append(read.refused)
-        if refused:
-            self._say("; ".join(refused), refused=True)
-        return refused
-
     def _say(self, text: str, refused: bool = False) -> None:
-        self._note = text
-        self.push_note.content = _note_html(text, refused)
+        if (text, refused) != self._note:
+            self._note = (text, refused)
+            self.push_note.content = _note_html(text, refused)
 
-    def _push(self) -> None:
-        refused = self._settle_fields()
-        push = self.push_input()
-        why = "; ".join(refused) or push_refusal(push)
+    def _refuse(self, why: str) -> None:
+        self._say(f"push refused: {why}", refused=True)
+        self._log(f"push refused: {why}")
+
+    def _pressed(self, client: object | None = None) -> None:
+        """Push pressed: the fields as they are now, or a refusal that says why."""
+        pressed_at = self.push_button.update_timestamp
+        read = read_push(self.texts(), self._bounds)
+        if not isinstance(read, PushInput):
+            self._refuse("; ".join(read))
+            return
+        typed_at = max(handle.update_timestamp for handle in self.fields.values())
+        if client is not None and pressed_at - typed_at < TYPING_GUARD:
+            self._refuse(
+                f"Push pressed {1000 * max(pressed_at - typed_at, 0.0):.0f} ms after a key: "
+                "the page may not have sent the last one; press Push again"
+            )
+            return
         status = self.live.snapshot().status
-        if not why and not status.advancing:
-            why = (
+        if not status.advancing:
+            self._refuse(
                 "the run is not advancing ("
                 + (
                     "paused: press Resume"
@@ -248,14 +224,22 @@ class DemoPage(FrameLoop):
                 )
                 + ")"
             )
-        if why:
-            self._say(f"push refused: {why}", refused=True)
-            self._log(f"push refused: {why}")
             return
-        self._say("Click the ground to aim from the robot.")
-        self.live.request_push(push)
+        self._push = read
+        typed = self.fields["direction"].value.strip()
+        wrapped = "" if float(typed) == read.direction else f" ({typed} deg wrapped)"
+        self._say(
+            f"pushed {format_field(read.impulse)} N s towards {format_field(read.direction)} "
+            f"deg{wrapped} over {format_field(read.duration)} s"
+        )
+        self.live.request_push(read)
+
+    def _reset(self) -> None:
+        self._say(DEFAULT_NOTE)
+        self.live.request_reset()
 
     def _toggle_pause(self) -> None:
+        self._say(DEFAULT_NOTE)
         paused = not self.live.snapshot().status.paused
         self.live.set_paused(paused)
         self.pause_button.label = "Resume" if paused else "Pause"
@@ -269,9 +253,8 @@ class DemoPage(FrameLoop):
             ("impulse", preset.impulse),
             ("duration", preset.duration),
         ):
-            field = self.fields[name]
-            field.value, field.pending = value, None
-            _set_value(field.handle, format_field(value))
+            _set_value(self.fields[name], format_field(value))
+        self._say(DEFAULT_NOTE)
         self._aimed()
 
     def _aimed(self) -> None:
@@ -281,23 +264,22 @@ class DemoPage(FrameLoop):
     def _on_click(self, event: viser.SceneClickEvent) -> None:
         point = ray_ground_intersection(event.ray_origin, event.ray_direction)
         state = self.live.snapshot().state
-        if point is None or state is None:
+        view = self.view.view_of(event.client)
+        if point is None or state is None or view is None:
             return
-        target = point + self.view.offset
+        target = point + view.offset
         direction = direction_towards(state.com, target)
         if direction is not None:
             x, y = target
             self._log(f"aim direction={direction:.0f} deg towards ({x:.2f}, {y:.2f}) m")
-            field = self.fields["direction"]
-            field.value, field.pending = float(round(direction)), None
-            _set_value(field.handle, format_field(field.value))
+            _set_value(self.fields["direction"], format_field(float(round(direction))))
             _set_value(self.preset, CUSTOM)
+            self._say(DEFAULT_NOTE)
             self._aimed()
 
     # ---------------------------------------------------------------- render thread
     def _frame(self, now: float, dt: float) -> bool:
-        """Draw when there is something new (a snapshot, a change, the aim arrow)."""
-        self._settle_fields(now)
+        """Publish when there is something new (a snapshot, a change, the aim arrow)."""
         snap = self.live.snapshot()
         aiming = now < self._aim_until
         if snap.serial == self._last_serial and not self._dirty and not aiming:
@@ -341,7 +323,7 @@ class DemoPage(FrameLoop):
                 f"<b>t = {s.time:.2f} s</b> · {state} · controller <b>{s.controller}</b> · "
                 f"{s.model} {robot}",
                 f"speed {s.speed:.2f}x real time (asked {s.slow_motion:g}x) · "
-                f"page {self.update_rate:.0f} Hz",
+                f"tabs draw {_rates(self.view.tab_rates())} frames/s",
                 f"pushes {snap.pushes_applied} · adjusted steps {snap.adjusted_steps}",
                 f"<small>last event: {html.escape(s.last_event or '-')}</small>",
             ]

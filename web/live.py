@@ -51,7 +51,8 @@ RECORD_PERIOD = 0.01  # [s] sampling period of trails and plots
 PUBLISH_PERIOD = 1.0 / 60.0  # [s] wall time between snapshots while running
 LAG_LIMIT = 0.25  # [s] simulated lag after which pacing restarts (machine too slow)
 SPEED_WINDOW = 1.0  # [s] wall time over which the speed is measured
-SLOW_MOTION_FACTORS = (1.0, 0.5, 0.25, 0.1)  # [-] simulated seconds per wall second
+# [-] simulated seconds per wall second; above 1 as fast as one core allows (G1 ~5x)
+SLOW_MOTION_FACTORS = (1.0, 0.5, 0.25, 0.1, 2.0, 4.0)
 
 
 def push_line(push: Push, source: str) -> str:
@@ -83,6 +84,9 @@ class LiveSimulation:
         controller: One of :data:`planner.parameters.CONTROLLERS`.
         scenario: Built-in scenario name or TOML path; its pushes are applied too.
         log: Called with each event line (default: print to stdout and flush).
+        log_steps: Log a line per step too (``rsg demo --quiet`` does not).
+        slow_motion: Simulated seconds per wall second at start, one of
+            :data:`SLOW_MOTION_FACTORS`.
 
     Raises:
         RsgError: Unknown model, robot, controller or scenario (from the builders).
@@ -95,8 +99,13 @@ class LiveSimulation:
         controller: str = "rsg",
         scenario: str = "walk",
         log: Callable[[str], None] | None = None,
+        log_steps: bool = True,
+        slow_motion: float = 1.0,
     ) -> None:
+        if slow_motion not in SLOW_MOTION_FACTORS:
+            raise ValueError(f"slow motion {slow_motion!r}: expected one of {SLOW_MOTION_FACTORS}")
         self.model = model
+        self._log_steps = log_steps
         self.robot = resolve_robot(model, robot)
         self._log = log or _print_line
         self._scenario_source: Scenario = load_scenario(scenario)
@@ -104,7 +113,7 @@ class LiveSimulation:
         self._worker = Worker(self._run, "rsg-live-sim")
         self._serial = 0
         self._paused = False
-        self._slow_motion = 1.0
+        self._slow_motion = float(slow_motion)
         self._speed = 0.0
         self._last_event = ""
         self._busy = ""
@@ -194,6 +203,7 @@ class LiveSimulation:
         self._plot = Trail(round(PLOT_TIME / RECORD_PERIOD), dimension=3)
         self._steps: list[StepMark] = []
         self._pushes_applied = 0
+        self._last_push: NDArray[np.float64] | None = None
         self._adjusted_steps = 0
         self._fall_reported = False
         self._out: PlannerOutput | None = None
@@ -299,6 +309,7 @@ class LiveSimulation:
         push = Push(loop.time, push_input.impulse_xy(), push_input.duration)
         loop.push_now(push)
         self._pushes_applied += 1
+        self._last_push = np.asarray(push.impulse, float)
         self._event(push_line(push, "page"))
 
     def _reset(self) -> None:
@@ -320,6 +331,7 @@ class LiveSimulation:
         for push in self._scenario.pushes:
             if time - 1e-9 <= push.time < time + loop.period - 1e-9:
                 self._pushes_applied += 1
+                self._last_push = np.asarray(push.impulse, float)
                 self._event(push_line(push, "scenario"))
         try:
             out = loop.tick()
@@ -335,7 +347,8 @@ class LiveSimulation:
             self._steps.append(mark)
             del self._steps[:-STEP_MARKS]
             self._adjusted_steps += int(mark.adjusted)
-            self._event(step_line(mark, out.step.lyapunov_before, out.step.lyapunov_after))
+            line = step_line(mark, out.step.lyapunov_before, out.step.lyapunov_after)
+            self._event(line, printed=self._log_steps)
         if loop.ticks % self._record_every == 0:
             measured = loop.measured
             omega = self._config.model.omega
@@ -349,9 +362,11 @@ class LiveSimulation:
             self._fall_reported = True
             self._event(f"fall t={loop.time:.3f} s reason={fall.reason}")
 
-    def _event(self, line: str) -> None:
+    def _event(self, line: str, printed: bool = True) -> None:
+        """``line`` becomes the status's last event; printed unless told not to."""
         self._last_event = line
-        self._log(line)
+        if printed:
+            self._log(line)
 
     # ----------------------------------------------------------------- snapshots
     def _publish(self) -> None:
@@ -390,6 +405,7 @@ class LiveSimulation:
             mass=loop.backend.mass,
             pushes_applied=self._pushes_applied,
             adjusted_steps=self._adjusted_steps,
+            last_push=self._last_push,
         )
 
     def _controller_state(self, loop: ClosedLoop) -> ControllerState | None:

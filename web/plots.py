@@ -30,6 +30,8 @@ THRESHOLD_COLOUR = "#e11e1e"
 LEVEL_COLOUR = "#1e6ee6"
 TRAIL_COLOUR = "#141414"
 RATIO_FLOOR = 1e-3  # [-] V_u / gamma_v shown at least this (log axis; 0 would be -inf)
+RATIO_CEILING = 1e4  # [-] and at most this: after a fall V_u grows without bound
+INSET_ZOOM = 4.0  # [-] the inset shows gamma_v's level set once the axes are this much wider
 NICE_STEPS = (1.0, 2.0, 5.0)
 
 
@@ -45,16 +47,17 @@ def nice_ceiling(value: float) -> float:
 
 
 def lyapunov_ratio(lyapunov: Array, threshold: float) -> Array:
-    """V_u / gamma_v, at least :data:`RATIO_FLOOR` (for a log axis)."""
+    """V_u / gamma_v, in [:data:`RATIO_FLOOR`, :data:`RATIO_CEILING`] (for a log axis)."""
     ratio = np.asarray(lyapunov, dtype=float) / max(threshold, 1e-300)
-    return np.maximum(ratio, RATIO_FLOOR)
+    return np.clip(np.nan_to_num(ratio, nan=RATIO_CEILING), RATIO_FLOOR, RATIO_CEILING)
 
 
 def log_axis_top(largest: float) -> float:
-    """Top of the V_u / gamma_v axis: the power of 10 above ``largest``, at least 10."""
+    """Top of the V_u / gamma_v axis: the power of 10 above ``largest``, in [10,
+    :data:`RATIO_CEILING`]."""
     if not (math.isfinite(largest) and largest > 0.0):
         return 10.0
-    return max(10.0, 10.0 ** math.ceil(math.log10(largest * 1.05)))
+    return min(RATIO_CEILING, max(10.0, 10.0 ** math.ceil(math.log10(largest * 1.05))))
 
 
 class DcmErrorPlot:
@@ -86,8 +89,20 @@ class DcmErrorPlot:
         axes.legend(loc="upper right", fontsize=7, framealpha=0.8)
         self.figure.subplots_adjust(left=0.2, right=0.96, bottom=0.15, top=0.91)
         self.half_range = 0.0  # [m]
+        # After a large push the axes grow and the gamma_v level set shrinks to a dot:
+        # an inset keeps it, and e_u near it, readable.
+        self.inset = self.figure.add_axes((0.66, 0.17, 0.28, 0.28))
+        self.inset.set_aspect("equal")
+        self.inset.set_xticks([])
+        self.inset.set_yticks([])
+        self.inset.set_visible(False)
+        self.inset_half_range = 0.0  # [m], 0 while the inset is hidden
+        (self.inset_threshold,) = self.inset.plot([], [], color=THRESHOLD_COLOUR, lw=1.2)
+        (self.inset_trail,) = self.inset.plot([], [], color=TRAIL_COLOUR, lw=0.7)
+        (self.inset_point,) = self.inset.plot([], [], "o", color=TRAIL_COLOUR, markersize=4)
+        self._inset_artists = (self.inset_threshold, self.inset_trail, self.inset_point)
         self._moving = (self.threshold_line, self.level_line, self.trail_line, self.point)
-        for artist in self._moving:
+        for artist in (*self._moving, *self._inset_artists):
             artist.set_animated(True)  # drawn over the cached background only
         self._background: object | None = None
 
@@ -114,13 +129,39 @@ class DcmErrorPlot:
         self.trail_line.set_data(trail[:, 0], trail[:, 1])
         self.point.set_data([dcm_error[0]], [dcm_error[1]])
         self.point.set_color(THRESHOLD_COLOUR if above_threshold else TRAIL_COLOUR)
-        if self._fit(threshold_curve, level_curve, trail, dcm_error) or self._background is None:
+        self.inset_threshold.set_data(threshold_curve[:, 0], threshold_curve[:, 1])
+        self.inset_trail.set_data(trail[:, 0], trail[:, 1])
+        self.inset_point.set_data([dcm_error[0]], [dcm_error[1]])
+        self.inset_point.set_color(self.point.get_color())
+        fitted = self._fit(threshold_curve, level_curve, trail, dcm_error)
+        inset_changed = self._fit_inset(threshold_curve)
+        if fitted or inset_changed or self._background is None:
             self.canvas.draw()  # axes, ticks, labels, legend: only when the range changes
             self._background = self.canvas.copy_from_bbox(self.figure.bbox)
         self.canvas.restore_region(self._background)
         for artist in self._moving:
             self.axes.draw_artist(artist)
+        if self.inset_half_range > 0.0:
+            for artist in self._inset_artists:
+                self.inset.draw_artist(artist)
         return np.asarray(self.canvas.buffer_rgba())[..., :3].copy()
+
+    def _fit_inset(self, threshold_curve: Array) -> bool:
+        """Show the inset (its half range) when the gamma_v level set is small in the
+        axes; True if that changed."""
+        extent = float(np.max(np.abs(threshold_curve))) if np.size(threshold_curve) else 0.0
+        wanted = nice_ceiling(1.3 * extent) if extent > 0.0 else 0.0
+        if not (extent > 0.0 and self.half_range > INSET_ZOOM * wanted):
+            wanted = 0.0
+        if wanted == self.inset_half_range:
+            return False
+        self.inset_half_range = wanted
+        self.inset.set_visible(wanted > 0.0)
+        if wanted > 0.0:
+            self.inset.set_xlim(-wanted, wanted)
+            self.inset.set_ylim(-wanted, wanted)
+            self.inset.set_title(f"±{100 * wanted:g} cm", fontsize=7, pad=2)
+        return True
 
     def _fit(self, *point_sets: Array) -> bool:
         """Set the axes' half range for the data; True if it changed."""

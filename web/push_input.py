@@ -4,14 +4,14 @@ Pure Python and NumPy (no viser), so it is tested without a browser.
 
 The page's number fields are text: what the browser's number inputs do with an
 empty or partial entry (keep the previous value, silently) is not what the user
-sees. :func:`read_field` turns a field's text into the value that will be used and
-the text the field must show for it, or refuses the text and says why.
+sees. :func:`read_push` reads the three fields' texts when Push is pressed and gives
+the push they ask for, exactly, or refuses it naming each bad field, its text and
+the range allowed; nothing is clipped.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -125,59 +125,82 @@ def paper_presets(mass: float) -> dict[str, PushInput]:
 
 
 # ----------------------------------------------------------------------------- fields
+DIRECTION_LIMIT = 360.0  # [deg] a typed direction is in [-360, 360], wrapped to (-180, 180]
+
+
 @dataclass(frozen=True)
-class FieldValue:
-    """What a number field holds once read.
+class FieldRule:
+    """What a push field accepts.
 
     Attributes:
-        value: The value that will be used [the field's unit].
-        text: What the field must show: ``value``, formatted.
-        refused: Why the typed text was refused ("" when it was accepted); the
-            value is then the previous one.
+        name: The field's name, for messages.
+        unit: Its unit.
+        low, high: The range allowed [unit].
+        low_open: ``low`` itself is refused (an impulse must be > 0).
     """
 
-    value: float
-    text: str
-    refused: str = ""
+    name: str
+    unit: str
+    low: float
+    high: float
+    low_open: bool = False
+
+    def allowed(self) -> str:
+        """The range, as the page and its messages say it."""
+        lower = "more than" if self.low_open else "from"
+        return f"{lower} {format_field(self.low)} to {format_field(self.high)} {self.unit}"
+
+    def read(self, text: str) -> float | str:
+        """The number typed as ``text``, or why it is refused (the field, the text,
+        the range allowed)."""
+        stripped = text.strip()
+        try:
+            number = float(stripped)
+        except ValueError:
+            number = math.nan
+        if not stripped:
+            return f"{self.name} is empty: allowed {self.allowed()}"
+        if not math.isfinite(number):
+            return f"{self.name} {stripped!r} is not a number: allowed {self.allowed()}"
+        below = number <= self.low if self.low_open else number < self.low
+        if below or number > self.high:
+            return f"{self.name} {stripped} {self.unit} is out of range: allowed {self.allowed()}"
+        return number
+
+
+def field_rules(bounds: PushBounds) -> dict[str, FieldRule]:
+    """The rules of the direction, impulse and duration fields for ``bounds``."""
+    return {
+        "direction": FieldRule("direction", "deg", -DIRECTION_LIMIT, DIRECTION_LIMIT),
+        "impulse": FieldRule("impulse", "N s", 0.0, bounds.impulse_max, low_open=True),
+        "duration": FieldRule("duration", "s", bounds.duration_min, bounds.duration_max),
+    }
+
+
+def read_push(texts: dict[str, str], bounds: PushBounds) -> PushInput | list[str]:
+    """The push the fields' texts ask for, exactly (the direction wrapped to (-180, 180]
+    deg, as the page says), or why it is refused: one reason per bad field.
+
+    Args:
+        texts: Field name (direction, impulse, duration) -> the text it holds.
+        bounds: The robot's push bounds.
+    """
+    values, refused = {}, []
+    for name, rule in field_rules(bounds).items():
+        read = rule.read(texts.get(name, ""))
+        if isinstance(read, str):
+            refused.append(read)
+        else:
+            values[name] = read
+    if refused:
+        return refused
+    return PushInput(wrap_degrees(values["direction"]), values["impulse"], values["duration"])
 
 
 def format_field(value: float) -> str:
     """A field's text for ``value``: up to 3 decimals, no trailing zeros."""
     text = f"{value:.3f}".rstrip("0").rstrip(".")
     return "0" if text in ("-0", "") else text
-
-
-def read_field(
-    text: str,
-    previous: float,
-    name: str,
-    unit: str,
-    normalise: Callable[[float], float],
-) -> FieldValue:
-    """The value of a number field whose text is ``text``.
-
-    Args:
-        text: What the user typed.
-        previous: The value in use before [unit].
-        name: The field's name, for the message.
-        unit: Its unit, for the message.
-        normalise: Brings a number into the field's range (wraps or clips).
-
-    Returns:
-        The normalised number and its text; for an empty or non-numeric text, the
-        previous value, its text, and why the text was refused.
-    """
-    stripped = text.strip()
-    try:
-        number = float(stripped)
-    except ValueError:
-        number = math.nan
-    if not math.isfinite(number):
-        shown = format_field(previous)
-        what = "empty" if not stripped else f"{stripped!r} is not a number"
-        return FieldValue(previous, shown, f"{name}: {what}; using {shown} {unit}")
-    value = normalise(number)
-    return FieldValue(value, format_field(value))
 
 
 def push_refusal(push: PushInput) -> str:

@@ -56,7 +56,12 @@ class ReplayPage(FrameLoop):
         self._speed = 1.0
         self._serial = 0
         self._dirty = True
-        self.view = PageView(server, urdf, controls=self._build_controls)
+        self.view = PageView(server, urdf, controls=self._build_controls, frame_rate=frame_rate)
+
+    def stop(self, timeout: float = 5.0) -> None:
+        """Stop publishing and every tab's drawing."""
+        super().stop(timeout)
+        self.view.stop()
 
     def _build_controls(self) -> None:
         gui = self.server.gui

@@ -99,6 +99,7 @@ def snapshot_at(replay: ReplayData, time: float, serial: int = 0, paused: bool =
     )
     plot = _window(replay, time, PLOT_TIME)
     foot_lower, foot_upper = sole_corners(window_min, window_max)
+    applied = int(np.sum(replay.pushes[:, 0] <= time + 1e-9))
     return Snapshot(
         serial=serial,
         state=state,
@@ -119,8 +120,9 @@ def snapshot_at(replay: ReplayData, time: float, serial: int = 0, paused: bool =
         foot_lower=foot_lower,
         foot_upper=foot_upper,
         mass=float(meta["mass"]),
-        pushes_applied=int(np.sum(replay.pushes[:, 0] <= time + 1e-9)),
+        pushes_applied=applied,
         adjusted_steps=int(np.sum(taken[:, 4] > 0.5)),
+        last_push=replay.pushes[applied - 1, 1:3] if applied else None,
     )
 
 

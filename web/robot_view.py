@@ -15,6 +15,7 @@ it. viser sends a pose only when it changed.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -93,11 +94,32 @@ def _visual_mesh(visual: yourdfpy.Visual, urdf: Path) -> trimesh.Trimesh | None:
     return mesh
 
 
+@functools.lru_cache(maxsize=4)
+def _link_meshes(
+    urdf: Path,
+) -> dict[tuple[str, int], tuple[NDArray, NDArray, tuple[int, int, int]]]:
+    """(link, visual index) -> (vertices [m], faces, colour) of the URDF's visuals, loaded
+    once per URDF: every browser tab builds its own robot from them."""
+    robot = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False).robot
+    materials = {m.name: m.color.rgba for m in robot.materials if m.color is not None}
+    meshes = {}
+    for link in robot.links:
+        for index, visual in enumerate(link.visuals):
+            mesh = _visual_mesh(visual, urdf)
+            if mesh is not None:
+                meshes[(link.name, index)] = (
+                    np.asarray(mesh.vertices, np.float32),
+                    np.asarray(mesh.faces, np.uint32),
+                    _colour_of(visual, materials),
+                )
+    return meshes
+
+
 class RobotView:
     """The robot's meshes under scene node ``root`` [m, rad].
 
     Args:
-        server: The viser server.
+        scene: The scene to draw in: a server's (every tab) or one client's.
         urdf: Path of the URDF (absolute mesh paths, e.g. the derived URDF).
         root: Scene node of the robot's base link (its pose is the base pose).
 
@@ -111,18 +133,16 @@ class RobotView:
             continuous.
     """
 
-    def __init__(self, server: viser.ViserServer, urdf: Path, root: str) -> None:
+    def __init__(self, scene: viser.SceneApi, urdf: Path, root: str) -> None:
         model = yourdfpy.URDF.load(urdf, build_scene_graph=False, load_meshes=False)
         robot = model.robot
-        materials = {m.name: m.color.rgba for m in robot.materials if m.color is not None}
+        meshes = _link_meshes(urdf)
         children: dict[str, list[yourdfpy.Joint]] = {}
         for joint in robot.joints:
             children.setdefault(joint.parent, []).append(joint)
         child_links = {joint.child for joint in robot.joints}
         base = next(link.name for link in robot.links if link.name not in child_links)
-        visuals = {link.name: link.visuals for link in robot.links}
 
-        scene = server.scene
         self.base = scene.add_frame(root, show_axes=False)
         self.nodes: dict[str, viser.SceneNodeHandle] = {root: self.base}
         self.link_nodes: dict[str, str] = {base: root}
@@ -145,20 +165,11 @@ class RobotView:
                     axis = np.asarray(joint.axis, dtype=float) / np.linalg.norm(joint.axis)
                     moving.append(_MovingJoint(joint.name, frame, wxyz, axis))
                 pending.append(joint.child)
-        for link, node in self.link_nodes.items():
-            for index, visual in enumerate(visuals[link]):
-                mesh = _visual_mesh(visual, urdf)
-                if mesh is None:
-                    continue
-                mesh_name = f"{node}/visual_{index}"
-                self.nodes[mesh_name] = scene.add_mesh_simple(
-                    mesh_name,
-                    np.asarray(mesh.vertices, np.float32),
-                    np.asarray(mesh.faces, np.uint32),
-                    color=_colour_of(visual, materials),
-                    cast_shadow=False,
-                    receive_shadow=False,
-                )
+        for (link, index), (vertices, faces, colour) in meshes.items():
+            mesh_name = f"{self.link_nodes[link]}/visual_{index}"
+            self.nodes[mesh_name] = scene.add_mesh_simple(
+                mesh_name, vertices, faces, color=colour, cast_shadow=False, receive_shadow=False
+            )
         order = {joint.name: index for index, joint in enumerate(robot.joints)}
         moving.sort(key=lambda joint: order[joint.name])
         self._moving = moving

@@ -96,6 +96,7 @@ class Snapshot:
         foot_lower, foot_upper: Sole corners around the ankle [m], shape (2,).
         mass: Robot mass [kg].
         pushes_applied: Number of pushes applied since the last reset.
+        last_push: Impulse of the last push applied [N s], shape (2,), or None.
         adjusted_steps: Number of adjusted steps since the last reset.
     """
 
@@ -112,3 +113,4 @@ class Snapshot:
     mass: float = 0.0
     pushes_applied: int = 0
     adjusted_steps: int = 0
+    last_push: Array | None = None

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from app.backends.base import FallStatus, InitialCondition
 from app.backends.physics_log import PhysicsLog
-from app.backends.pybullet_robot import SimulatedRobot
+from app.backends.pybullet_robot import GROUND_HALF_SIZE, SimulatedRobot
 from app.lowlevel import RobotMeasurement
 from app.stabilizer.config import OPTION_NAMES, StabilizerConfig
 from app.stabilizer.controller import WholeBodyController
@@ -220,6 +220,8 @@ class PyBulletBackend:
         position, quaternion = self.sim.base_pose()
         if position[2] < self.description.fall_base_height:
             return FallStatus(True, f"pelvis height {position[2]:.3f} m")
+        if np.max(np.abs(position[:2])) > GROUND_HALF_SIZE:
+            return FallStatus(True, f"off the ground at ({position[0]:.1f}, {position[1]:.1f}) m")
         tilt = _tilt(quaternion)
         if tilt > self.description.fall_tilt:
             return FallStatus(True, f"pelvis tilt {np.degrees(tilt):.0f} deg")

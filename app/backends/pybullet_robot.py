@@ -1,10 +1,11 @@
 """A biped in its own PyBullet world: loading, its sensors and its joint motors.
 
 One :class:`SimulatedRobot` owns one ``BulletClient`` in DIRECT mode (several can
-coexist in a process), a flat ground with friction, and the robot loaded from the
-derived URDF with the URDF's inertias, its fixed-joint links merged into their
-parents (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per
-physics step; a ground contact of the head is reported as one of ``torso_link``).
+coexist in a process), a flat ground with friction (200 km wide: no run reaches its
+edge, :data:`GROUND_HALF_SIZE`), and the robot loaded from the derived URDF with
+the URDF's inertias, its fixed-joint links merged into their parents
+(:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per physics
+step; a ground contact of the head is reported as one of ``torso_link``).
 PyBullet's own joint motors are off (``VELOCITY_CONTROL`` with zero force): the
 joints are torque-driven by :class:`app.backends.joint_motors.JointMotors`, the G1's low-level
 PD law with feed-forward, at every physics step (:meth:`actuate`); :meth:`measure`
@@ -33,6 +34,11 @@ with native_output_silenced():  # pybullet prints its build time when first impo
     from pybullet_utils.bullet_client import BulletClient
 
 GRAVITY = 9.81  # [m/s^2]
+# PyBullet's plane.urdf is a 200 m box (its top at z = 0), scaled here so that no run
+# reaches its edge: 0.12 m/s for a week or 0.5 m/s for two days stays on it. The
+# box, not GEOM_PLANE, keeps the soles' box-box contact algorithm.
+GROUND_SCALE = 1000.0  # [-]
+GROUND_HALF_SIZE = 100.0 * GROUND_SCALE  # [m] the ground spans |x|, |y| <= this
 
 
 class SimulatedRobot:
@@ -60,7 +66,7 @@ class SimulatedRobot:
             deterministicOverlappingPairs=1,
         )
         client.setAdditionalSearchPath(pybullet_data.getDataPath())
-        self.ground = client.loadURDF("plane.urdf", useFixedBase=True)
+        self.ground = client.loadURDF("plane.urdf", useFixedBase=True, globalScaling=GROUND_SCALE)
         client.changeDynamics(self.ground, -1, lateralFriction=description.ground_friction)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
         urdf = derived_urdf(description, merged=True)

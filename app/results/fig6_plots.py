@@ -125,11 +125,13 @@ def plot_dcm_error(result: RunResult, path: Path) -> None:
     fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.5), width_ratios=[1, 1.4])
     ex, ey = result.column("dcm_error_x"), result.column("dcm_error_y")
     vmax = max(result.max_lyapunov, 2 * gamma)
-    for level in np.geomspace(gamma / 4, vmax, 6):
-        pts = design.level_set(level)
-        ax.plot(pts[:, 0], pts[:, 1], color="lightgray", lw=0.8)
-    pts = design.level_set(gamma)
-    ax.plot(pts[:, 0], pts[:, 1], color="black", lw=2, label="V_u = gamma_v")
+    # placo-wpg has no Lyapunov function (a zero P_u): its e_u is drawn alone.
+    if np.all(np.linalg.eigvalsh(design.matrix) > 0.0):
+        for level in np.geomspace(gamma / 4, vmax, 6):
+            pts = design.level_set(level)
+            ax.plot(pts[:, 0], pts[:, 1], color="lightgray", lw=0.8)
+        pts = design.level_set(gamma)
+        ax.plot(pts[:, 0], pts[:, 1], color="black", lw=2, label="V_u = gamma_v")
     ax.plot(ex, ey, color="tab:blue", lw=1, label="e_u(t)")
     for k in _push_marks(result):
         ax.plot(ex[k], ey[k], "s", color="lime", markeredgecolor="black")
