@@ -2,12 +2,14 @@
 
 Starts ``rsg demo`` (this checkout), opens the page in Debian's Chromium and clicks
 Push several times, as a user does (a mouse click at the button). A probe injected
-into the page records, on the page's own clock, the click (``pointerdown``) and the
-end of every animation frame in which the page applied a scene frame; each scene
-frame carries a token with the number of pushes it shows (``web.client_view``), so
-the first frame that shows a push is known. Click-to-screen is the time from the
-click to the end of that frame. Also reported: the tab's drawn frame rate and the
-time from the click to the simulation's ``push t=`` line (click-to-applied).
+into the page records the end of every animation frame in which the page applied a
+scene frame; each scene frame carries a token with the number of pushes it shows
+(``web.client_view``), so the first frame that shows a push is known. Click-to-screen
+is the time from the mouse click (sent to the browser) to the end of that frame, on
+this machine's clock. Also reported: the tab's drawn frame rate, the input delay (the
+click to the page's ``pointerdown``: a page busy drawing handles input between
+frames) and the time from the click to the simulation's ``push t=`` line
+(click-to-applied).
 
 Two renderers, both software (this machine has no GPU): ``slow`` is a 1280 x 800
 window, ``fast`` a 480 x 300 one (a fifth of the pixels to shade). Needs
@@ -71,10 +73,12 @@ PROBE = """
   window.requestAnimationFrame = (callback) => raf((stamp) => {
     callback(stamp);
     if (applied !== null) {
-      window.__rsgFrames.push([applied, performance.now()]); applied = null;
+      window.__rsgFrames.push([applied, performance.timeOrigin + performance.now()]);
+      applied = null;
     }
   });
-  window.addEventListener("pointerdown", () => window.__rsgClicks.push(performance.now()), true);
+  window.addEventListener("pointerdown",
+    () => window.__rsgClicks.push(performance.timeOrigin + performance.now()), true);
 })();
 """
 
@@ -101,7 +105,7 @@ def measure(model: str, renderer: str, pushes: int, settle: float) -> dict:
     threading.Thread(
         target=lambda: [lines.append((time.perf_counter(), line)) for line in stdout], daemon=True
     ).start()
-    screen, applied, rates = [], [], []
+    screen, applied, rates, delays = [], [], [], []
     try:
         while not any("open http" in line for _, line in lines):
             time.sleep(0.2)
@@ -122,17 +126,17 @@ def measure(model: str, renderer: str, pushes: int, settle: float) -> dict:
                 button.scroll_into_view_if_needed()
                 box = button.bounding_box()
                 before = len(lines)
-                clicked = time.perf_counter()
+                clicked, clicked_epoch = time.perf_counter(), 1000.0 * time.time()
                 page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
                 while time.perf_counter() - clicked < TIMEOUT:
                     frames = page.evaluate("window.__rsgFrames")
                     if any(pushes_of(key) >= number for key, _ in frames):
                         break
                     time.sleep(0.05)
-                click = page.evaluate("window.__rsgClicks")[-1]
+                delays.append((page.evaluate("window.__rsgClicks")[-1] - clicked_epoch) / 1000.0)
                 frames = page.evaluate("window.__rsgFrames")
-                shown = [t for key, t in frames if pushes_of(key) >= number and t >= click]
-                screen.append((min(shown) - click) / 1000.0 if shown else TIMEOUT)
+                shown = [t for key, t in frames if pushes_of(key) >= number and t >= clicked_epoch]
+                screen.append((min(shown) - clicked_epoch) / 1000.0 if shown else TIMEOUT)
                 found = [t for t, line in lines[before:] if line.startswith("push t=")]
                 applied.append(found[0] - clicked if found else TIMEOUT)
                 recent = [t for _, t in frames if t >= frames[-1][1] - 5000.0]
@@ -149,6 +153,7 @@ def measure(model: str, renderer: str, pushes: int, settle: float) -> dict:
         "viewport": list(VIEWPORTS[renderer]),
         "frames_per_s": statistics.median(rates) if rates else 0.0,
         "click_to_screen_s": screen,
+        "input_delay_s": delays,
         "click_to_applied_s": applied,
     }
 
@@ -167,6 +172,7 @@ def main() -> None:
         f"{args.model}, {args.renderer} renderer {result['viewport'][0]}x"
         f"{result['viewport'][1]}, tab draws {result['frames_per_s']:.1f} frames/s: "
         f"click-to-screen median {statistics.median(screen):.2f} s, max {max(screen):.2f} s; "
+        f"input delay median {statistics.median(result['input_delay_s']):.2f} s; "
         f"click-to-applied median {statistics.median(applied):.2f} s over {len(screen)} pushes "
         f"({', '.join(f'{v:.2f}' for v in screen)})"
     )

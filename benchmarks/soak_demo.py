@@ -46,7 +46,9 @@ def rss_mib(pid: int) -> float:
 
 def click(page, name: str) -> None:
     """A mouse click at the centre of the button ``name``, as a user clicks."""
-    box = page.get_by_role("button", name=name, exact=True).bounding_box()
+    button = page.get_by_role("button", name=name, exact=True)
+    button.evaluate("element => element.scrollIntoView({block: 'center'})")
+    box = button.bounding_box()
     page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
 
 
@@ -99,7 +101,7 @@ def main() -> int:
     url = f"http://127.0.0.1:{port}"
     start = time.monotonic()
     memory = [rss_mib(demo.pid)]
-    reconnects = pauses = 0
+    reconnects = pauses = pressed = 0
     times: list[float] = []
     try:
         with sync_playwright() as api, tempfile.TemporaryDirectory() as profile:
@@ -126,6 +128,7 @@ def main() -> int:
                     )
                     page.wait_for_timeout(500)
                     click(page, "Push")
+                    pressed += 1
                     if rng.random() < 0.1:  # pause a moment, then resume
                         page.wait_for_timeout(3000)
                         click(page, "Pause")
@@ -158,6 +161,7 @@ def main() -> int:
         "command": " ".join(command[2:]),
         "simulated_s": max(times) if times else 0.0,
         "wall_s": wall,
+        "pushes_pressed": pressed,
         "pushes_applied": sum(x.startswith("push t=") for x in lines),
         "pushes_refused": sum(x.startswith("push refused") for x in lines),
         "falls": [x for x in lines if x.startswith("fall")],

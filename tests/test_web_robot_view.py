@@ -106,3 +106,18 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
         backend.close()
         world.remove()
     assert swing_heights[1] > 0.02 and swing_heights[2] > 0.02, swing_heights  # mid-swing
+
+
+def test_meshes_are_drawn_with_fewer_faces_within_the_tolerance():
+    """Software WebGL is bound by vertices: a fine mesh is decimated, its surface within
+    MESH_TOLERANCE of the original; no tolerance keeps the mesh as it is."""
+    import trimesh
+
+    from web.robot_view import MESH_TOLERANCE, simplified
+
+    sphere = trimesh.creation.icosphere(subdivisions=5, radius=0.1)
+    reduced = simplified(sphere)
+    assert len(reduced.faces) <= 0.35 * len(sphere.faces)
+    _, distance, _ = trimesh.proximity.closest_point(reduced, sphere.vertices)
+    assert np.percentile(distance, 99) <= MESH_TOLERANCE
+    assert simplified(sphere, tolerance=0.0) is sphere
