@@ -107,12 +107,12 @@ def main() -> int:
         with sync_playwright() as api, tempfile.TemporaryDirectory() as profile:
             context = api.chromium.launch_persistent_context(
                 profile, executable_path="/usr/bin/chromium", headless=True, args=FLAGS,
-                viewport={"width": 900, "height": 600},
+                viewport={"width": 640, "height": 400},
             )  # fmt: skip
             page = open_tab(context, url)
             last_push = last_reconnect = time.monotonic()
             while True:
-                page.wait_for_timeout(2000)
+                page.wait_for_timeout(5000)
                 now = time.monotonic()
                 simulated = sim_time(page)
                 times.append(simulated)
@@ -121,10 +121,10 @@ def main() -> int:
                 if now - last_push >= args.push_every:
                     last_push = now
                     page.locator(f"xpath={INPUT.format('Direction [deg]')}").first.fill(
-                        f"{rng.uniform(-180.0, 180.0):.1f}"
+                        f"{rng.uniform(-180.0, 180.0):.1f}", force=True
                     )
                     page.locator(f"xpath={INPUT.format('Impulse [N s]')}").first.fill(
-                        f"{rng.uniform(low, high):.2f}"
+                        f"{rng.uniform(low, high):.2f}", force=True
                     )
                     page.wait_for_timeout(500)
                     click(page, "Push")

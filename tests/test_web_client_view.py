@@ -69,3 +69,16 @@ def test_the_world_is_shifted_under_the_robot_and_the_grid_follows(server):
     com = frame(1, 0, acting=False).snap.state.com
     np.testing.assert_allclose(view.world.position[:2], -com, atol=1e-12)
     np.testing.assert_allclose(view.grid.position[:2], np.round(com), atol=1e-12)
+
+
+def test_the_same_state_redrawn_does_not_move_the_view(server):
+    """A redraw without a new state (the robot hidden, say) leaves the world where it was
+    drawn: the side view's camera and the drawn soles stay on the ground's line."""
+    view = tab_of(server)
+    view._draw(frame(1, 0, acting=False), 0.0)
+    view.offset = view.offset + 0.5  # as if the view was still following the robot
+    view.world.position = (-view.offset[0], -view.offset[1], 0.0)
+    before = np.array(view.world.position)
+    hidden = frame(1, 0, acting=False)
+    view._draw(Frame(2, hidden.snap, None, robot_visible=False), 1.0)
+    np.testing.assert_array_equal(view.world.position, before)

@@ -116,6 +116,7 @@ class ClientView:
         self.offset = np.zeros(2)  # [m] world point shown at the view's origin
         self.stance = np.zeros(2)  # [m] stance ankle drawn last, in the world
         self._drawn: int | None = None
+        self._snap_serial = -1  # the snapshot drawn last
         self._pushes_drawn = 0
         self._push_shown: tuple[Array, float] | None = None  # (impulse, wall time until)
         self._acks: deque[float] = deque()
@@ -242,9 +243,11 @@ class ClientView:
                 self.robot.visible = frame.robot_visible
             if state is not None:
                 self.stance = np.asarray(state.stance, float)
-                target = np.asarray(state.com, float)
-                jump = float(np.linalg.norm(target - self.offset)) > 2.0
-                self.offset = target if jump or dt <= 0.0 else follow(self.offset, target, dt)
+                if snap.serial != self._snap_serial:  # the same state redrawn stays put
+                    self._snap_serial = snap.serial
+                    target = np.asarray(state.com, float)
+                    jump = float(np.linalg.norm(target - self.offset)) > 2.0
+                    self.offset = target if jump or dt <= 0.0 else follow(self.offset, target, dt)
                 self.world.position = (-self.offset[0], -self.offset[1], 0.0)
                 cell = np.round(self.offset / 1.0) * 1.0
                 self.grid.position = (cell[0], cell[1], 0.0)
