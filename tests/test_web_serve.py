@@ -101,3 +101,14 @@ def test_a_malformed_host_is_refused_with_a_clear_message(run_folder, command, c
     assert code == 2
     assert f"rsg {command}: error: --host 'bad host!': not an IP address" in err
     assert "in use" not in err
+
+
+@pytest.mark.parametrize(
+    "args,says",
+    [(("--controller", "placo-wpg"), "--controller='placo-wpg' is not allowed: expected one"),
+     (("--speed", "3"), "argument --speed: invalid choice: 3.0 (choose from 0.1, 0.25, 0.5, 1.0")],
+)  # fmt: skip
+def test_a_demo_it_cannot_serve_is_refused_saying_why(args, says):
+    done = rsg("demo", "--model", "lipm", *args, "--port", str(free_port()))
+    assert done.returncode == 2
+    assert says in done.stderr and "Traceback" not in done.stderr, done.stderr

@@ -136,8 +136,8 @@ def run(args: argparse.Namespace) -> int:
             "--controller",
             "placo-wpg",
             f"one of {', '.join(CONTROLLERS)} (placo-wpg has its own preview and IK and no "
-            "DCM-error Lyapunov level for the page; run it headless with rsg run --controller "
-            "placo-wpg and watch it with rsg replay)",
+            "DCM-error Lyapunov level for the page to draw; run it headless: rsg run "
+            "--controller placo-wpg)",
         )
 
     return int(main(args))

@@ -52,7 +52,7 @@ PUBLISH_PERIOD = 1.0 / 60.0  # [s] wall time between snapshots while running
 LAG_LIMIT = 0.25  # [s] simulated lag after which pacing restarts (machine too slow)
 SPEED_WINDOW = 1.0  # [s] wall time over which the speed is measured
 # [-] simulated seconds per wall second; above 1 as fast as one core allows (G1 ~5x)
-SLOW_MOTION_FACTORS = (1.0, 0.5, 0.25, 0.1, 2.0, 4.0)
+SLOW_MOTION_FACTORS = (0.1, 0.25, 0.5, 1.0, 2.0, 4.0)
 
 
 def push_line(push: Push, source: str) -> str:
