@@ -82,3 +82,40 @@ def test_the_same_state_redrawn_does_not_move_the_view(server):
     hidden = frame(1, 0, acting=False)
     view._draw(Frame(2, hidden.snap, None, robot_visible=False), 1.0)
     np.testing.assert_array_equal(view.world.position, before)
+
+
+def test_a_slow_tab_gets_the_newest_frame_each_time_not_a_backlog(server):
+    """A tab that takes 0.2 s to apply a frame while frames are published at up to 200 Hz
+    is sent at most one frame per 0.2 s, each the newest published when it was sent (the
+    bounds hold however loaded the machine is: each frame waits for its token)."""
+    published: list[Frame] = []
+    sent: list[tuple[int, int]] = []  # (frame drawn, newest published then)
+
+    class SlowStorage:
+        def get_item(self, key: str, timeout: float) -> None:
+            time.sleep(0.2)  # the tab draws the frame
+
+    client = SimpleNamespace(
+        scene=server.scene, client_id=7, atomic=server.atomic, flush=lambda: None,
+        local_storage=SlowStorage(),
+    )  # fmt: skip
+    view = ClientView(client, None, lambda: published[-1] if published else None, 60.0)
+    draw = view._draw
+
+    def recording_draw(frame: Frame, dt: float) -> str:
+        sent.append((frame.serial, published[-1].serial))
+        return draw(frame, dt)
+
+    view._draw = recording_draw  # type: ignore[method-assign]
+    view.start()
+    start = time.perf_counter()
+    serial = 0
+    while time.perf_counter() - start < 1.5:
+        serial += 1
+        published.append(frame(serial, 0, acting=False))
+        view.changed()
+        time.sleep(0.005)
+    view.stop()
+    assert 2 <= len(sent) <= 9 < serial, sent  # 1.5 s / 0.2 s + 1, not one per frame
+    assert all(newest - drawn <= 3 for drawn, newest in sent), sent  # a few ms apart
+    assert view.frame_rate <= 5.0 + 1e-9
