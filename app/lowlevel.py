@@ -1,14 +1,16 @@
 """The robot's low-level interface: what the controller sends and what it reads.
 
-Modelled on the Unitree G1's own low level (``LowCmd`` / ``LowState`` of unitree_sdk2):
-per joint, a target angle and velocity, a stiffness and damping and a feed-forward
-torque, evaluated by the motor at its own rate as
+Modelled on the Unitree G1's own low level (``LowCmd`` / ``LowState`` of unitree_sdk2,
+``unitree_hg``): per joint, a target angle and velocity, a stiffness and damping and a
+feed-forward torque, evaluated by the motor at its own rate as
 
-    tau = kp (q* - q) + kd (qd* - qd) + tau_ff,    clipped at the joint's effort limit;
+    tau = kp (q* - q) + kd (qd* - qd) + tau_ff,    clipped at the motor's limit;
 
-and back, per tick, the joint encoders, the IMU and (on robots that have them) foot
-force sensors. The simulator's truth that a real robot does not measure is kept in
-separate fields, so the controller's use of it is visible.
+and back, per tick, what the robot senses: per motor the encoder's angle and velocity and
+the estimated torque, the pelvis IMU (attitude, gyroscope, accelerometer) and, on robots
+that have them (Talos, not G1), the ankles' force-torque sensors. The simulator's truth
+is a separate record (:class:`SimulatorTruth`) for judging and logging only: the
+controller's interface takes a :class:`RobotMeasurement`, which has no field of it.
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ class JointCommand:
 
 @dataclass(frozen=True)
 class FootForce:
-    """A foot's ground reaction, from a foot force sensor.
+    """A foot's ground reaction.
 
     Attributes:
         normal_force: Vertical force [N] (>= 0).
@@ -52,37 +54,64 @@ class FootForce:
 
 
 @dataclass(frozen=True)
-class RobotMeasurement:
-    """What the controller reads at the start of a tick.
+class ImuReading:
+    """The pelvis IMU (its frame is the pelvis's, at ``RobotDescription.imu_position``).
 
-    On a real G1: ``joint_positions`` and ``joint_velocities`` (motor encoders),
-    ``base_orientation`` and ``base_angular_velocity`` (the pelvis IMU). Foot force
-    sensors are an option of some G1 versions; here they are simulated from the
-    contact forces (``foot_forces``). ``base_position`` and ``base_linear_velocity``
-    are the simulator's truth: a real robot estimates them (leg odometry,
-    :mod:`app.stabilizer.estimator`).
+    Attributes:
+        orientation: Attitude, quaternion (x, y, z, w): roll and pitch referenced to
+            gravity, yaw integrated from the gyroscope (it drifts).
+        angular_velocity: Gyroscope [rad/s], IMU frame, shape (3,).
+        linear_acceleration: Accelerometer [m/s^2], IMU frame, shape (3,): the specific
+            force, acceleration minus gravity (+9.81 up at rest), averaged over the tick.
+    """
+
+    orientation: NDArray[np.float64]
+    angular_velocity: NDArray[np.float64]
+    linear_acceleration: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class RobotMeasurement:
+    """What the robot senses, read by the controller at the start of a tick.
 
     Attributes:
         time: Time [s].
-        joint_positions: Joint angles [rad], in the robot's joint order.
-        joint_velocities: Joint velocities [rad/s].
-        base_orientation: Pelvis orientation, quaternion (x, y, z, w).
-        base_angular_velocity: Pelvis angular velocity in the pelvis frame [rad/s].
-        foot_forces: Foot -> its ground reaction (feet without contact absent).
-        base_position: Pelvis position in the world [m] (simulator truth).
-        base_linear_velocity: Pelvis velocity in the world [m/s] (simulator truth).
+        joint_positions: Encoder angles [rad], in the robot model's joint order.
+        joint_velocities: Encoder velocities [rad/s].
+        joint_torques: The motors' estimated torques [N m] (from their current).
+        imu: The pelvis IMU.
+        foot_forces: Foot -> its force-torque sensor's reading (feet in the air read
+            zero), or None on a robot without foot sensors.
     """
 
     time: float
     joint_positions: NDArray[np.float64]
     joint_velocities: NDArray[np.float64]
-    base_orientation: NDArray[np.float64]
-    base_angular_velocity: NDArray[np.float64]
-    foot_forces: dict[str, FootForce]
-    base_position: NDArray[np.float64]
-    base_linear_velocity: NDArray[np.float64]
+    joint_torques: NDArray[np.float64]
+    imu: ImuReading
+    foot_forces: dict[str, FootForce] | None
 
-    def normal_force(self, foot: str) -> float:
-        """Vertical ground force on ``foot`` [N] (0 without contact)."""
-        reading = self.foot_forces.get(foot)
-        return 0.0 if reading is None else reading.normal_force
+
+@dataclass(frozen=True)
+class SimulatorTruth:
+    """The simulated robot's true state, for judging and logging only.
+
+    Attributes:
+        time: Time [s].
+        base_position: Pelvis (URDF base frame) position in the world [m].
+        base_orientation: Pelvis orientation, quaternion (x, y, z, w).
+        base_linear_velocity: Pelvis origin velocity in the world [m/s].
+        base_angular_velocity: Pelvis angular velocity in the pelvis frame [rad/s].
+        joint_positions: Joint angles [rad], the model's joint order.
+        joint_velocities: Joint velocities [rad/s].
+        foot_forces: Foot -> its ground reaction (feet without contact absent).
+    """
+
+    time: float
+    base_position: NDArray[np.float64]
+    base_orientation: NDArray[np.float64]
+    base_linear_velocity: NDArray[np.float64]
+    base_angular_velocity: NDArray[np.float64]
+    joint_positions: NDArray[np.float64]
+    joint_velocities: NDArray[np.float64]
+    foot_forces: dict[str, FootForce]

@@ -53,6 +53,39 @@ class JointImpedance:
             raise ParameterError("damping", self.damping, "a number in [0, 1e3] N m s/rad")
 
 
+@dataclass(frozen=True)
+class MotorModel:
+    """One motor's limits and friction, as the joint sees them.
+
+    Attributes:
+        peak_torque: Torque limit [N m] below ``full_torque_speed`` (Y1).
+        braking_torque: Limit [N m] of a torque against the motion (Y2).
+        full_torque_speed: Speed [rad/s] up to which ``peak_torque`` is available (X1).
+        no_load_speed: Speed [rad/s] at which the torque limit reaches zero (X2).
+        static_friction: Coulomb friction [N m] (Fs).
+        viscous_friction: Viscous friction [N m s/rad] (Fd).
+    """
+
+    peak_torque: float
+    braking_torque: float
+    full_torque_speed: float
+    no_load_speed: float
+    static_friction: float = 0.0
+    viscous_friction: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("peak_torque", "braking_torque", "full_torque_speed", "no_load_speed"):
+            if not getattr(self, name) > 0.0:
+                raise ParameterError(name, getattr(self, name), "a number > 0")
+        if not self.no_load_speed > self.full_torque_speed:
+            raise ParameterError(
+                "no_load_speed", self.no_load_speed, f"> full_torque_speed {self.full_torque_speed}"
+            )
+        for name in ("static_friction", "viscous_friction"):
+            if not getattr(self, name) >= 0.0:
+                raise ParameterError(name, getattr(self, name), "a number >= 0")
+
+
 def _check_physics_time_step(value: float) -> None:
     """Raise a ParameterError naming ``physics_time_step`` unless 0.5 ms <= value <= 5 ms."""
     if not (isinstance(value, float) and 0.0005 <= value <= 0.005):
@@ -150,6 +183,14 @@ class RobotDescription:
             motor rows, so a cheaper physics step) and in the IK (masked); neither
             actuated nor measured. Not the upper-body or leg joints the controller
             moves.
+        imu_position: Where the pelvis IMU is, in the base link's frame [m] (its
+            axes are the base link's).
+        foot_force_sensors: Whether the ankles carry force-torque sensors.
+        motors: Joint name -> its motor's torque-speed curve and friction
+            (:class:`MotorModel`); joints not listed: the effort limit, no friction.
+        motor_armature: Joint name -> its motor's armature, the rotor inertia reflected
+            through the gear [kg m^2] (:mod:`robots.rotor_inertia`); joints not listed
+            have none.
         backend_options: This robot's whole-body stabilizer options
             (:class:`app.stabilizer.config.StabilizerConfig`) and ``control_period``
             [s], where they differ from the defaults.
@@ -193,6 +234,10 @@ class RobotDescription:
     sole_box_collision: bool = False
     upper_body_joints: tuple[str, ...] = ()
     locked_joints: tuple[str, ...] = ()
+    imu_position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    foot_force_sensors: bool = False
+    motors: Mapping[str, MotorModel] = field(default_factory=dict)
+    motor_armature: Mapping[str, float] = field(default_factory=dict)
     backend_options: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -254,6 +299,8 @@ class RobotDescription:
         object.__setattr__(self, "standing_posture", MappingProxyType(dict(self.standing_posture)))
         object.__setattr__(self, "backend_options", MappingProxyType(dict(self.backend_options)))
         object.__setattr__(self, "joint_impedance", MappingProxyType(dict(self.joint_impedance)))
+        object.__setattr__(self, "motors", MappingProxyType(dict(self.motors)))
+        object.__setattr__(self, "motor_armature", MappingProxyType(dict(self.motor_armature)))
 
     @property
     def pendulum_height(self) -> float:

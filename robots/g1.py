@@ -37,8 +37,11 @@ under position control, kept since):
   ``kinematics/pendulum.py``), so the planner's LIPM is c_z + h_r = 0.76 m tall.
 * ``dcm_inset`` 0.02 m and |hdot| <= 5 N m: the planner's row (27c') and the bound
   on its feedback angular momentum rate.
-* ``physics_time_step`` 2 ms with 75 solver iterations: the motors' stable PD law
-  (``app/backends/joint_motors.py``) is stable at this step; 1 ms doubles the physics' cost.
+* ``physics_time_step`` 1 ms with 75 solver iterations: the driver's plain PD law
+  (``app/backends/joint_motors.py``), explicit at each physics step, chatters on the light
+  feet at 2 ms and the walk falls after 18 steps; at 1 ms it walks.
+* the motors (``MOTORS``, ``ARMATURE``): unitree_rl_lab's torque-speed curves, friction
+  and armatures; the IMU at the URDF's ``imu_in_pelvis``; no foot force sensors.
 * ``locked_joints``: the ten distal arm joints are welded at their standing angles
   (the flywheel uses the waist and the shoulders' pitch and roll): 19 actuated
   joints, a physics step 0.58 times as long.
@@ -50,7 +53,7 @@ under position control, kept since):
 
 from __future__ import annotations
 
-from robots.description import JointImpedance, RobotDescription, SoleRectangle
+from robots.description import JointImpedance, MotorModel, RobotDescription, SoleRectangle
 
 _LEG_BEND = {"hip_pitch": -0.35, "knee": 0.7, "ankle_pitch": -0.35}
 _ARMS = {"shoulder_pitch": 0.2, "elbow": 0.9}
@@ -96,6 +99,46 @@ def _impedance(joint: str) -> JointImpedance:
     return JointImpedance(STIFFNESS_FACTOR * kp, DAMPING_FACTOR * kd)
 
 
+# G1's motors, from unitree_rl_lab's actuator models (assets/robots/unitree_actuators.py):
+# torque-speed curve (Y1, Y2 [N m], X1, X2 [rad/s]), friction (Fs [N m], Fd [N m s/rad])
+# and armature [kg m^2], the rotor and gear inertias reflected through the gears (mjlab's
+# G1 constants give the same armatures).
+MOTORS = {
+    "7520-14": MotorModel(71.0, 83.3, 22.63, 35.52, 1.6, 0.16),
+    "7520-22": MotorModel(111.0, 131.0, 14.5, 22.7, 2.4, 0.24),
+    "5020": MotorModel(24.8, 31.9, 30.86, 40.13, 0.6, 0.06),
+    "4010": MotorModel(4.8, 8.6, 15.3, 24.76, 0.6, 0.06),
+}
+ARMATURE = {"7520-14": 0.01017752, "7520-22": 0.025101925, "5020": 0.003609725, "4010": 0.00425}
+_MOTOR = {
+    "hip_pitch": "7520-14", "hip_yaw": "7520-14", "waist_yaw": "7520-14",
+    "hip_roll": "7520-22", "knee": "7520-22",
+    "shoulder_pitch": "5020", "shoulder_roll": "5020", "shoulder_yaw": "5020",
+    "elbow": "5020", "wrist_roll": "5020", "wrist_pitch": "4010", "wrist_yaw": "4010",
+}  # fmt: skip
+# The ankles and the waist's roll and pitch: two 5020 motors through a linkage. Its
+# torque-speed curve at the joint is not published: no curve (the URDF's effort limit
+# caps the torque), twice a 5020's friction and armature.
+_LINKAGE = ("ankle_pitch", "ankle_roll", "waist_roll", "waist_pitch")
+_LINKAGE_MOTOR = MotorModel(
+    1e3, 1e3, 1e3, 2e3, 2 * MOTORS["5020"].static_friction, 2 * MOTORS["5020"].viscous_friction
+)
+
+
+def _kind(joint: str) -> str:
+    return joint.removeprefix("left_").removeprefix("right_").removesuffix("_joint")
+
+
+def _motor(joint: str) -> MotorModel:
+    kind = _kind(joint)
+    return _LINKAGE_MOTOR if kind in _LINKAGE else MOTORS[_MOTOR[kind]]
+
+
+def _armature(joint: str) -> float:
+    kind = _kind(joint)
+    return 2.0 * ARMATURE["5020"] if kind in _LINKAGE else ARMATURE[_MOTOR[kind]]
+
+
 # Every joint has gains, the welded ones too (they move with ``--set locked_joints=none``).
 _JOINTS = [
     f"{side}_{joint}_joint"
@@ -127,8 +170,11 @@ G1 = RobotDescription(
     foot_spacing=0.23,
     standing_posture=STANDING_POSTURE,
     joint_impedance={joint: _impedance(joint) for joint in _JOINTS},
+    imu_position=(0.04525, 0.0, -0.08339),  # the URDF's imu_in_pelvis; no foot sensors
+    motors={joint: _motor(joint) for joint in _JOINTS},
+    motor_armature={joint: _armature(joint) for joint in _JOINTS},
     total_mass=33.3,
-    physics_time_step=0.002,
+    physics_time_step=0.001,
     solver_iterations=75,
     fall_base_height=0.45,
     swing_height=0.06,

@@ -70,6 +70,12 @@ _EFFORTS = {
 }
 
 
+# talos.srdf's rotor parameters (pinocchio.loadRotorParameters): every motor a rotor of
+# 1e-5 kg m^2 behind a 100:1 gear, an armature of 1e-5 x 100^2 = 0.1 kg m^2.
+ARMATURE = 1e-5 * 100.0**2  # [kg m^2]
+_GEARED = [j for j in _EFFORTS if j.startswith(("leg_", "arm_", "torso_", "head_"))]
+
+
 def _impedance(joint: str, effort: float) -> JointImpedance:
     ankle = joint.startswith("leg_") and joint.endswith(("_5_joint", "_6_joint"))
     angle, damping_time = (1.0, 0.05) if ankle else (0.1, 0.025)
@@ -91,6 +97,8 @@ TALOS = RobotDescription(
     standing_posture=STANDING_POSTURE,
     joint_impedance={joint: _impedance(joint, effort) for joint, effort in _EFFORTS.items()},
     total_mass=90.27,
+    foot_force_sensors=True,  # six-axis force-torque sensors at the ankles
+    motor_armature={joint: ARMATURE for joint in _GEARED},
     fall_base_height=0.6,
     swing_height=0.06,
     sole_box_collision=True,

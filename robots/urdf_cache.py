@@ -6,7 +6,8 @@ The installed URDFs cannot be used as they are: meshes are ``package://`` URIs
 without ``<inertial>``. When the description asks for it (``sole_box_collision``),
 the foot's collision shapes (G1: four 5 mm spheres, which chatter and bounce in
 PyBullet at every touchdown) are replaced by one thin box spanning the sole
-rectangle, bottom face on the sole plane. :func:`derived_urdf` writes a fixed copy to
+rectangle, bottom face on the sole plane. Each motor's armature is added to its
+child link (:mod:`robots.rotor_inertia`). :func:`derived_urdf` writes a fixed copy to
 ``$RSG_CACHE_DIR/robots/<name>-<hash>/robot.urdf`` (default cache
 ``~/.cache/rsg``); with ``merged=True``, ``robot-merged.urdf``, the same robot
 with the description's ``locked_joints`` welded at their standing angle and the
@@ -27,11 +28,12 @@ from pathlib import Path
 
 from planner.exceptions import ParameterError, RsgError
 from robots.description import RobotDescription
+from robots.rotor_inertia import add_rotor_inertia
 from robots.urdf_merge import lock_joints, merge_fixed_links
 
 DISTRIBUTION = "example-robot-data"
 PACKAGE_PREFIX = "package://"
-DERIVATION_VERSION = "4"  # bump when the derivation below (or the merge) changes
+DERIVATION_VERSION = "5"  # bump when the derivation below (or the merge) changes
 TINY_MASS = 1e-6  # [kg] mass given to links without <inertial>
 TINY_INERTIA = 1e-9  # [kg m^2]
 FOOT_FRAMES = {"left": "left_foot", "right": "right_foot"}
@@ -152,6 +154,7 @@ def derive_urdf_text(description: RobotDescription, source_text: str, share_dir:
         if description.sole_box_collision:
             _replace_sole_collision(root, description, description.ankle_link(foot))
     _add_fixed_frame(root, TRUNK_FRAME, description.trunk_link, (0.0, 0.0, 0.0))
+    add_rotor_inertia(root, description.motor_armature)
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
@@ -188,6 +191,7 @@ def derived_urdf(description: RobotDescription, merged: bool = False) -> Path:
         repr(tuple(float(v) for v in description.sole_offset)),
         repr((description.sole, description.sole_box_collision)),
         repr(locked_angles(description)),
+        repr(sorted(description.motor_armature.items())),
     )
     key = "\n".join((DERIVATION_VERSION, str(share_dir), *settings, source_text))
     digest = hashlib.sha256(key.encode("utf-8")).hexdigest()[:16]

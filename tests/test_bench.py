@@ -45,22 +45,22 @@ def test_bench_command_writes_json(tmp_path: Path, capsys: pytest.CaptureFixture
 def test_bench_times_the_robot_it_is_given_with_set(
     tmp_path: Path, capsys: pytest.CaptureFixture
 ) -> None:
-    """``rsg bench --set locked_joints=none --set physics_time_step=0.001`` times G1
-    with all 29 joints in the physics at 1 kHz; the default has the description's
-    locked joints welded (fewer motors) at 500 Hz, and the table says which step;
+    """``rsg bench --set locked_joints=none --set physics_time_step=0.0005`` times G1
+    with all 29 joints in the physics at 2 kHz; the default has the description's
+    locked joints welded (fewer motors) at 1 kHz, and the table says which step;
     a bad value is an error naming the field before anything runs."""
     from app.experiments.bench import bench_robot
 
     counts, steps, labels = [], [], []
-    for overrides in ((), (("locked_joints", "none"), ("physics_time_step", "0.001"))):
+    for overrides in ((), (("locked_joints", "none"), ("physics_time_step", "0.0005"))):
         report = bench_robot("g1", 0.05, overrides=overrides)
         assert report["simulated"] == pytest.approx(0.05) and not report["fell"]
         counts.append(report["motors"])
         steps.append(report["physics_time_step"])
         labels.append([line for line in format_bench(report).splitlines() if "physics" in line])
-    assert counts == [19, 29] and steps == [0.002, 0.001]
-    assert labels[0][0].startswith("| physics step (2 ms) |")
-    assert labels[1][0].startswith("| physics step (1 ms) |")
+    assert counts == [19, 29] and steps == [0.001, 0.0005]
+    assert labels[0][0].startswith("| physics step (1 ms) |")
+    assert labels[1][0].startswith("| physics step (0.5 ms) |")
     assert main(["bench", "--set", "solver_iterations=0", "--out", str(tmp_path)]) == 2
     assert "solver_iterations" in capsys.readouterr().err
     assert not (tmp_path / "bench.json").exists()

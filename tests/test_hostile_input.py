@@ -466,9 +466,9 @@ OVERRIDES = [
     ),
     set_case(
         "control-period-not-multiple",
-        "control_period=0.003",
+        "control_period=0.0035",
         "--set control_period",
-        "'0.003'",
+        "'0.0035'",
         "whole multiple of the physics step",
         model="pybullet",
     ),
@@ -518,9 +518,9 @@ OVERRIDES = [
     set_case(
         "estimator-unknown",
         "estimator=kalman",
-        "--set estimator",
-        "'kalman'",
-        "truth or odometry",
+        "--set",
+        "'estimator'",
+        "landing_depth",
         model="pybullet",
     ),
     set_case(

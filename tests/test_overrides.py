@@ -62,7 +62,6 @@ def test_each_name_goes_where_it_applies() -> None:
         (
             ("swing_preparation_time", "0.3"),
             ("landing_depth", "0.003"),
-            ("estimator", "odometry"),
             ("control_period", "0.004"),
             ("crossing_margin", "0.03"),
         )
@@ -70,7 +69,6 @@ def test_each_name_goes_where_it_applies() -> None:
     assert parsed.description == {"swing_preparation_time": 0.3}
     assert parsed.backend == {
         "landing_depth": 0.003,
-        "estimator": "odometry",
         "control_period": 0.004,
     }
     assert parsed.rsg == {"crossing_margin": 0.03}
@@ -122,16 +120,14 @@ def test_the_robot_backend_and_planner_receive_the_overrides() -> None:
         (
             ("swing_preparation_time", "0.3"),
             ("landing_depth", "0.004"),
-            ("estimator", "odometry"),
             ("control_period", "0.004"),
             ("crossing_margin", "0.03"),
         ),
     )
     try:
         stabilizer = backend.controller.config
-        assert stabilizer.landing_depth == 0.004 and stabilizer.estimator == "odometry"
+        assert stabilizer.landing_depth == 0.004
         assert backend.controller.landing.depth == 0.004
-        assert backend.controller.estimator.source == "odometry"
         assert backend.control_period == 0.004 == backend.controller.period
         assert config.rsg.swing_preparation_time == 0.3
         assert backend.timing.ready == 0.3  # the swing foot is timed on the same T_SP
@@ -341,7 +337,7 @@ def test_the_physics_time_step_reaches_pybullet_and_the_backend() -> None:
             robot.close()
         backend, config, initial = build_robot_backend("g1", "rsg", overrides=overrides)
         try:
-            assert backend.sim.time_step == backend.sim.motors.time_step == step
+            assert backend.sim.time_step == step
             result = run_closed_loop(backend, config, Scenario("walk", 0.1), initial)
             assert not result.fall.fell
             assert backend.sim.time == pytest.approx(0.1)  # ticks x substeps x step

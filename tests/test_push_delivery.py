@@ -107,7 +107,7 @@ def test_a_push_a_fall_cuts_short_is_listed_with_what_it_delivered(tmp_path: Pat
 
 
 def test_pybullet_applies_each_ticks_force_at_every_physics_step(tmp_path: Path) -> None:
-    """G1 (10 ms tick, 2 ms physics): a push shorter than a physics step, one shorter
+    """G1 (10 ms tick, 1 ms physics): a push shorter than a physics step, one shorter
     than a tick and one over several ticks act with their whole impulse in the time
     series and in physics.csv (drawn in physics.png)."""
     pushes = [(0.2, (1.5, 0.0), 1e-6), (0.31, (0.0, 1.0), 0.004), (0.4, (-1.0, 1.0), 0.05)]
@@ -121,5 +121,5 @@ def test_pybullet_applies_each_ticks_force_at_every_physics_step(tmp_path: Path)
     ticks = _read_csv(tmp_path / "timeseries.csv")
     np.testing.assert_allclose(_impulse_in(ticks, 0.01, 0.0, 0.5), expected, rtol=1e-5)
     physics = _read_csv(tmp_path / "physics.csv")
-    np.testing.assert_allclose(_impulse_in(physics, 0.002, 0.0, 0.6), expected, rtol=1e-5)
+    np.testing.assert_allclose(_impulse_in(physics, 0.001, 0.0, 0.6), expected, rtol=1e-5)
     assert (tmp_path / "physics.png").read_bytes()[:4] == b"\x89PNG"

@@ -22,7 +22,7 @@ def _cache_in_tmp(tmp_path_factory, monkeypatch):
 
 
 def test_every_number_option_has_a_range_and_the_defaults_are_in_it():
-    assert set(OPTION_NAMES) == {*RANGES, "estimator"}
+    assert set(OPTION_NAMES) == set(RANGES)
     assert len(OPTION_NAMES) <= 12  # the issue: about a dozen options
     config = StabilizerConfig()
     for name, (low, high) in RANGES.items():
@@ -50,15 +50,6 @@ def test_each_number_option_refuses_values_out_of_its_range_or_of_the_wrong_type
     for value in (low, high, (low + high) / 2):
         assert getattr(StabilizerConfig(**{name: value}), name) == value
     assert StabilizerConfig(friction=1).friction == 1  # an int is a number
-
-
-@pytest.mark.parametrize("value", ["kalman", "", 1, None])
-def test_the_estimator_is_truth_or_odometry(value):
-    with pytest.raises(ParameterError) as error:
-        StabilizerConfig(estimator=value)
-    assert error.value.field == "estimator"
-    assert "truth" in error.value.allowed and "odometry" in error.value.allowed
-    assert StabilizerConfig(estimator="odometry").estimator == "odometry"
 
 
 def test_a_robots_backend_options_are_its_stabilizer_options():

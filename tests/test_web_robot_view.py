@@ -58,7 +58,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
     from robots.urdf_cache import derived_urdf
     from web.robot_view import RobotView
 
-    backend, config, initial = build_backend("pybullet", "g1", "rsg")
+    backend, config, initial = build_backend("pybullet", "g1", "rsg", reality="ideal")
     push = Push(1.5, np.array([0.0, 4.0]), 0.1)
     loop = ClosedLoop(backend, config, Scenario("walk", 3.0, (push,)), initial)
     world = server.scene.add_frame("/world", show_axes=False, position=WORLD_SHIFT)
@@ -70,10 +70,21 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
         for foot, link in (("left", "left_ankle_roll_link"), ("right", "right_ankle_roll_link"))
     }
     swing_heights = []
+    swung: list[str] = []
     try:
-        for time in (0.0, 0.35, 1.15, 1.65):  # start, mid-swing right, mid-swing left, pushed
-            while loop.time < time - 1e-9:
-                loop.tick()
+        # start, the first foot mid-swing, the other mid-swing, pushed
+        for wanted in (None, "first", "second", 1.65):
+            if isinstance(wanted, float):
+                while loop.time < wanted - 1e-9:
+                    loop.tick()
+            elif wanted is not None:  # until a sole that has not swung yet is 3 cm up
+                while True:
+                    loop.tick()
+                    up = [f for f, p in backend.sole_positions().items() if p[2] > 0.03]
+                    if up and up[0] not in swung:
+                        swung.append(up[0])
+                        break
+            time = round(loop.time, 3)
             position, quaternion_xyzw, joints = backend.robot_configuration()
             x, y, z, w = quaternion_xyzw
             view.update(position, np.array([w, x, y, z]), joints)

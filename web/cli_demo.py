@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import argparse
 
-from app.commands.arguments import add_robot_argument
+from app.commands.arguments import add_reality_argument, add_robot_argument
 from planner.parameters import CONTROLLERS
 from web.live import SLOW_MOTION_FACTORS
 
@@ -16,6 +16,7 @@ examples:
   rsg demo                                 # G1 in PyBullet, http://127.0.0.1:8080
   rsg demo --model lipm --port 8081        # point-mass LIPM, fast
   rsg demo --scenario paper-fig6           # the paper's two pushes, plus yours
+  rsg demo --reality randomized --reality-seed 4   # G1 with drawn model errors and noise
 
 The page shows the robot, its footholds, the ZMP window, ZMP/CoM/DCM, the DCM error
 against the Lyapunov level sets (Fig. 6(c)), V_u / gamma_v on a log axis and the time
@@ -79,6 +80,7 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
         help="pybullet: full robot (URDF meshes); lipm: point mass (default: pybullet)",
     )
     add_robot_argument(demo)
+    add_reality_argument(demo, reality_seed=True)
     demo.add_argument(
         "--controller",
         choices=(*CONTROLLERS, "placo-wpg"),

@@ -12,6 +12,8 @@ from pathlib import Path
 
 import viser
 
+from app.reality import DEFAULT_PROFILE
+
 from .live import LiveSimulation
 from .serve import check_address, serve
 
@@ -46,7 +48,12 @@ def main(args: argparse.Namespace) -> int:
         args.scenario,
         log_steps=not getattr(args, "quiet", False),
         slow_motion=getattr(args, "speed", 1.0),
+        reality=getattr(args, "reality", DEFAULT_PROFILE),
+        reality_seed=getattr(args, "reality_seed", 0),
     )
+    draw = live.reality_draw()  # before the simulation thread starts
+    if draw is not None:
+        print(f"rsg demo: {draw.describe()}", flush=True)
     urdf = _robot_urdf(args.model, args.robot)
 
     def start(server: viser.ViserServer):  # noqa: ANN202

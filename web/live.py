@@ -24,9 +24,10 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from app.reality import DEFAULT_PROFILE, RealityDraw, check_profile
 from app.runner import ClosedLoop
 from app.scenarios import Scenario, load_scenario
-from app.setup.build import build_backend, resolve_robot
+from app.setup.build import backend_reality, build_backend, resolve_robot
 from planner.exceptions import RsgError
 from planner.parameters import CONTROLLERS
 from planner.types import PlannerOutput, Push
@@ -87,6 +88,9 @@ class LiveSimulation:
         log_steps: Log a line per step too (``rsg demo --quiet`` does not).
         slow_motion: Simulated seconds per wall second at start, one of
             :data:`SLOW_MOTION_FACTORS`.
+        reality: The full robot's reality profile (:mod:`app.reality`; ignored on
+            ``lipm``), drawn from ``reality_seed``: every rebuild (another controller)
+            meets the same robot.
 
     Raises:
         RsgError: Unknown model, robot, controller or scenario (from the builders).
@@ -101,10 +105,14 @@ class LiveSimulation:
         log: Callable[[str], None] | None = None,
         log_steps: bool = True,
         slow_motion: float = 1.0,
+        reality: str = DEFAULT_PROFILE,
+        reality_seed: int = 0,
     ) -> None:
         if slow_motion not in SLOW_MOTION_FACTORS:
             raise ValueError(f"slow motion {slow_motion!r}: expected one of {SLOW_MOTION_FACTORS}")
         self.model = model
+        self.reality = check_profile(reality)
+        self.reality_seed = reality_seed
         self._log_steps = log_steps
         self.robot = resolve_robot(model, robot)
         self._log = log or _print_line
@@ -176,9 +184,16 @@ class LiveSimulation:
             raise ValueError(f"controller {controller!r}: expected one of {', '.join(CONTROLLERS)}")
         self._requests.put(("controller", controller))
 
+    def reality_draw(self) -> RealityDraw | None:
+        """The reality the full robot's backend applies (None on the LIPM)."""
+        loop = self._require_loop()
+        return backend_reality(loop.backend, self.reality, self.reality_seed)
+
     # ------------------------------------------------------------------- building
     def _build(self, controller: str) -> None:
-        backend, config, initial = build_backend(self.model, self.robot, controller)
+        backend, config, initial = build_backend(
+            self.model, self.robot, controller, reality=self.reality, seed=self.reality_seed
+        )
         if self._loop is not None:
             self._loop.backend.close()
         scenario, _ = self._scenario_source.scaled_to(backend.mass)

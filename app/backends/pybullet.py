@@ -27,6 +27,7 @@ from app.backends.base import FallStatus, InitialCondition
 from app.backends.physics_log import PhysicsLog
 from app.backends.pybullet_robot import GROUND_HALF_SIZE, SimulatedRobot
 from app.lowlevel import RobotMeasurement
+from app.reality import DEFAULT_PROFILE, RealityDraw, robot_reality
 from app.stabilizer.config import OPTION_NAMES, StabilizerConfig
 from app.stabilizer.controller import WholeBodyController
 from kinematics.swing_foot import SwingTiming
@@ -35,7 +36,8 @@ from planner.exceptions import ParameterError
 from planner.types import Foot, MeasuredState, PlannerOutput, Vector2
 from robots import get_robot
 from robots.description import RobotDescription
-from robots.urdf_cache import locked_angles
+from robots.model_error import perturbed_text
+from robots.urdf_cache import derived_urdf, locked_angles
 
 DEFAULT_CONTROL_PERIOD = 0.01  # [s]
 CONTROL_PERIOD_RANGE = (0.002, 0.012)  # [s] measured on G1 (README, "--set")
@@ -74,6 +76,34 @@ def check_backend_options(description: RobotDescription, options: Mapping[str, o
         )
 
 
+def simulated_robot(description: RobotDescription, reality: RealityDraw) -> SimulatedRobot:
+    """The simulated robot with ``reality``'s sensors, delay, gains and model errors."""
+    urdf_text = None
+    if reality.model_error:
+        urdf_text = perturbed_text(
+            derived_urdf(description, merged=True).read_text(encoding="utf-8"),
+            reality.link_mass_scale,
+            (reality.torso_link, reality.torso_added_mass),
+            (reality.torso_link, reality.com_offset),
+        )
+    sim = SimulatedRobot(
+        description,
+        noise=reality.noise,
+        yaw_bias=reality.gyro_yaw_bias,
+        rng=reality.sample_rng(),
+        delay=reality.delay,
+        urdf_text=urdf_text,
+        ground_friction=reality.ground_friction,
+    )
+    names = sim.model_joint_names
+    scales = (
+        np.array([reality.stiffness_scale.get(n, 1.0) for n in names]),
+        np.array([reality.damping_scale.get(n, 1.0) for n in names]),
+    )
+    sim.set_gain_scales(*scales)
+    return sim
+
+
 class PyBulletBackend:
     """A full humanoid in PyBullet implementing :class:`app.backends.base.Backend`.
 
@@ -82,6 +112,8 @@ class PyBulletBackend:
             give the controller's options and the control period.
         timing: The planner's step timing (for the swing foot).
         physics_log: Records every physics step (None: nothing).
+        reality: The sensors' noise, the control delay and the model's errors
+            (:mod:`app.reality`; None: the nominal profile).
 
     Attributes:
         name: ``"pybullet"``.
@@ -101,6 +133,7 @@ class PyBulletBackend:
         robot: str | RobotDescription = "g1",
         timing: SwingTiming | None = None,
         physics_log: PhysicsLog | None = None,
+        reality: RealityDraw | None = None,
     ) -> None:
         self.description = robot if isinstance(robot, RobotDescription) else get_robot(robot)
         options = self.description.backend_options
@@ -108,7 +141,8 @@ class PyBulletBackend:
         self.control_period = float(options.get("control_period", DEFAULT_CONTROL_PERIOD))  # type: ignore[arg-type]
         self._substeps = round(self.control_period / self.description.physics_time_step)
         self._locked_angles = locked_angles(self.description)
-        self.sim = SimulatedRobot(self.description)
+        self.reality = reality or robot_reality(self.description, DEFAULT_PROFILE, 0)
+        self.sim = simulated_robot(self.description, self.reality)
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
         self.controller = WholeBodyController(
@@ -150,6 +184,7 @@ class PyBulletBackend:
         )
         self.sim.time = 0.0
         self.sim.set_motor_target(target)
+        self.sim.sensors.reset(self.reality.sample_rng())
         self.timers.clear()
         self.ticks = 0
         self._measurement = self.sim.measure()
@@ -193,9 +228,7 @@ class PyBulletBackend:
         force = np.array([push_force[0], push_force[1], 0.0]) if any(push_force) else None
         self.sim.actuate(
             joint_command,
-            self._measurement,
             self._substeps,
-            self.controller.expected_contact_force,
             force,
             None if self.physics_log is None else self.physics_log.record,
         )

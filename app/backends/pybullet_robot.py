@@ -6,23 +6,28 @@ edge, :data:`GROUND_HALF_SIZE`), and the robot loaded from the derived URDF with
 the URDF's inertias, its fixed-joint links merged into their parents
 (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per physics
 step; a ground contact of the head is reported as one of ``torso_link``).
-PyBullet's own joint motors are off (``VELOCITY_CONTROL`` with zero force): the
-joints are torque-driven by :class:`app.backends.joint_motors.JointMotors`, the G1's low-level
-PD law with feed-forward, at every physics step (:meth:`actuate`); :meth:`measure`
-gives the low-level measurement record (:mod:`app.lowlevel`).
+The joints are torque-driven by :class:`app.backends.joint_motors.JointMotors`, the G1
+driver's law on the low-level command alone, at every physics step (:meth:`actuate`);
+PyBullet's own joint motors hold only the motors' Coulomb friction (``VELOCITY_CONTROL``
+to zero velocity with that force). :meth:`measure` gives what the robot senses
+(:mod:`app.backends.sensors`), :meth:`truth` the simulator's state (:mod:`app.lowlevel`).
 Frames: PyBullet's base pose is the base link's *inertial* frame;
 :meth:`base_pose` converts it to the URDF base frame.
 """
 
 from __future__ import annotations
 
+import tempfile
+from collections import deque
 from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from app.backends.joint_motors import JointMotors
-from app.lowlevel import FootForce, JointCommand, RobotMeasurement
+from app.backends.sensors import NoiseLevels, Sensors
+from app.lowlevel import FootForce, JointCommand, RobotMeasurement, SimulatorTruth
 from kinematics.native_output import native_output_silenced
 from kinematics.robot_model import RobotModel, yaw_of
 from robots.description import RobotDescription
@@ -53,7 +58,26 @@ class SimulatedRobot:
         time: Simulated time [s].
     """
 
-    def __init__(self, description: RobotDescription) -> None:
+    def __init__(
+        self,
+        description: RobotDescription,
+        noise: NoiseLevels | None = None,
+        yaw_bias: float = 0.0,
+        rng: np.random.Generator | None = None,
+        delay: float = 0.0,
+        urdf_text: str | None = None,
+        ground_friction: float | None = None,
+    ) -> None:
+        """Args:
+        description: The robot.
+        noise: The sensors' noise (None: exact readings).
+        yaw_bias: The gyroscope's yaw bias [rad/s].
+        rng: The sensors' noise stream.
+        delay: How late [s] the low-level command reaches the motors (rounded to
+            physics steps).
+        urdf_text: The physics URDF's text (None: the description's derived URDF).
+        ground_friction: Friction of the ground and soles [-] (None: the description's).
+        """
         self.description = description
         self.time_step = description.physics_time_step
         with native_output_silenced():  # pybullet prints "argv[0]=" at connect
@@ -67,10 +91,17 @@ class SimulatedRobot:
         )
         client.setAdditionalSearchPath(pybullet_data.getDataPath())
         self.ground = client.loadURDF("plane.urdf", useFixedBase=True, globalScaling=GROUND_SCALE)
-        client.changeDynamics(self.ground, -1, lateralFriction=description.ground_friction)
+        friction = description.ground_friction if ground_friction is None else ground_friction
+        client.changeDynamics(self.ground, -1, lateralFriction=friction)
         flags = pybullet.URDF_USE_INERTIA_FROM_FILE
         urdf = derived_urdf(description, merged=True)
-        self.body = client.loadURDF(str(urdf), [0, 0, 1], flags=flags)
+        if urdf_text is None:
+            self.body = client.loadURDF(str(urdf), [0, 0, 1], flags=flags)
+        else:  # a model error: loaded from a file of its own, deleted once read
+            with tempfile.TemporaryDirectory(dir=urdf.parent) as folder:
+                path = Path(folder) / urdf.name
+                path.write_text(urdf_text, encoding="utf-8")
+                self.body = client.loadURDF(str(path), [0, 0, 1], flags=flags)
 
         self.joint_indices: list[int] = []
         self.joint_names: list[str] = []
@@ -90,11 +121,13 @@ class SimulatedRobot:
             client.changeDynamics(
                 self.body,
                 link,
-                lateralFriction=description.ground_friction,
+                lateralFriction=friction,
                 spinningFriction=description.sole_spinning_friction,
                 frictionAnchor=1,
             )
         self.link_count = client.getNumJoints(self.body)
+        for link in range(-1, self.link_count):  # PyBullet's default damping of 0.04 on every link
+            client.changeDynamics(self.body, link, linearDamping=0.0, angularDamping=0.0)
         self.link_masses = np.array(
             [client.getDynamicsInfo(self.body, link)[0] for link in range(-1, self.link_count)]
         )
@@ -113,8 +146,24 @@ class SimulatedRobot:
         self._model_indices = [
             self.joint_indices[self.joint_names.index(name)] for name in model.joint_names
         ]
-        self.motors = JointMotors(model, self.time_step)
-        self._motor_target = np.zeros(len(self.joint_names))
+        self.model_joint_names = list(model.joint_names)
+        self.motors = JointMotors(
+            model.effort_limits, [description.motors.get(name) for name in model.joint_names]
+        )
+        count = len(self._model_indices)
+        client.setJointMotorControlArray(
+            self.body,
+            self._model_indices,
+            pybullet.VELOCITY_CONTROL,
+            targetVelocities=[0.0] * count,
+            forces=self.motors.static_friction.tolist(),
+        )
+        self._gain_scales = (np.ones(count), np.ones(count))
+        self._delay_steps = round(delay / self.time_step)
+        self._queue: deque[tuple[NDArray[np.float64], ...]] = deque(maxlen=self._delay_steps + 1)
+        self._motor_target = np.zeros(count)
+        self.applied_torques = np.zeros(count)
+        self.sensors = Sensors(description, noise, yaw_bias, rng)
 
     # ----------------------------------------------------------------- state
     def set_configuration(
@@ -262,9 +311,9 @@ class SimulatedRobot:
         return yaw_of(rotation)
 
     # ------------------------------------------------------- torque control
-    def measure(self) -> RobotMeasurement:
-        """Encoders, IMU, foot forces and the base's true pose and velocity (joints in
-        the rigid-body model's order, :class:`kinematics.robot_model.RobotModel`)."""
+    def truth(self) -> SimulatorTruth:
+        """The simulator's state (joints in the rigid-body model's order,
+        :class:`kinematics.robot_model.RobotModel`): for judging and logging only."""
         states = self.client.getJointStates(self.body, self._model_indices)
         position, quaternion = self.base_pose()
         inertial_position, _ = self.client.getBasePositionAndOrientation(self.body)
@@ -277,74 +326,81 @@ class SimulatedRobot:
         forces = {
             foot: FootForce(force, cop) for foot, (cop, force) in self.foot_pressure().items()
         }
-        return RobotMeasurement(
+        return SimulatorTruth(
             time=self.time,
+            base_position=np.asarray(position, float),
+            base_orientation=np.asarray(quaternion, float),
+            base_linear_velocity=origin_velocity,
+            base_angular_velocity=rotation.T @ np.asarray(angular, float),
             joint_positions=np.array([s[0] for s in states]),
             joint_velocities=np.array([s[1] for s in states]),
-            base_orientation=np.asarray(quaternion, float),
-            base_angular_velocity=rotation.T @ np.asarray(angular, float),
             foot_forces=forces,
-            base_position=np.asarray(position, float),
-            base_linear_velocity=origin_velocity,
         )
 
+    def measure(self) -> RobotMeasurement:
+        """What the robot senses now (:mod:`app.backends.sensors`); the motors' torques are
+        the drivers' over the last tick, averaged (the low level reports them at every
+        physics step)."""
+        return self.sensors.read(self.truth(), self.applied_torques)
+
+    def set_gain_scales(self, stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> None:
+        """Factors on each motor's kp and kd [-], the model's joint order: the real gains'
+        error from the commanded ones."""
+        self._gain_scales = (np.asarray(stiffness, float), np.asarray(damping, float))
+
     def set_motor_target(self, angles: NDArray[np.float64]) -> None:
-        """Where the next tick's target angles start from [rad] (after a reset)."""
+        """Hold ``angles`` [rad] (after a reset): the motors' pending commands are this
+        posture with the commanded gains and no feed-forward, and the next tick's target
+        starts from it."""
         self._motor_target = np.asarray(angles, float).copy()
+        self._queue.clear()
+        self.applied_torques = np.zeros(len(self._motor_target))
 
     def actuate(
         self,
         command: JointCommand,
-        measurement: RobotMeasurement,
         steps: int,
-        expected_contact_force: NDArray[np.float64],
         base_force_world: NDArray[np.float64] | None = None,
         observer: Callable[[SimulatedRobot, NDArray[np.float64] | None], None] | None = None,
     ) -> None:
-        """Run ``steps`` physics steps with the motors on ``command`` (torque control).
+        """Run ``steps`` physics steps with the motors on ``command``.
 
-        ``measurement`` is the state at the start of the tick (the motors' model
-        uses its true base state); ``expected_contact_force`` is J^T f of the contact
-        forces expected over the tick (:mod:`app.backends.joint_motors`). ``base_force_world``
-        [N] pushes the pelvis; ``observer`` is called after each physics step.
+        The command stream the low level receives: at each physics step the target
+        angle moves linearly from the last tick's to ``command.position``; it reaches the
+        motors ``delay`` late. ``base_force_world`` [N] pushes the pelvis; ``observer``
+        is called after each physics step.
         """
-        motors = self.motors
-        model = motors.model
-        q = np.concatenate(
-            [measurement.base_position, measurement.base_orientation, measurement.joint_positions]
-        )
-        rotation = np.array(
-            self.client.getMatrixFromQuaternion(measurement.base_orientation)
-        ).reshape(3, 3)
-        v = np.concatenate(
-            [
-                rotation.T @ measurement.base_linear_velocity,
-                measurement.base_angular_velocity,
-                measurement.joint_velocities,
-            ]
-        )
-        model.update(q, v)
-        motors.prepare(command, self._motor_target, expected_contact_force)
-        self._motor_target = command.position.copy()
+        kp = command.stiffness * self._gain_scales[0]
+        kd = command.damping * self._gain_scales[1]
+        start = self._motor_target
+        if not self._queue:  # after a reset: the motors held the first target
+            hold = (start, np.zeros_like(start), kp, kd, np.zeros_like(start))
+            self._queue.extend([hold] * self._queue.maxlen)  # type: ignore[operator]
+        queue, motors, client = self._queue, self.motors, self._client_id
+        applied = np.zeros(len(start))
         for step in range(1, steps + 1):
-            states = pybullet.getJointStates(
-                self.body, self._model_indices, physicsClientId=self._client_id
+            target = start + (step / steps) * (command.position - start)
+            queue.append((target, command.velocity, kp, kd, command.torque))
+            position, velocity, stiffness, damping, torque = queue[0]
+            states = pybullet.getJointStates(self.body, self._model_indices, physicsClientId=client)
+            q = np.array([s[0] for s in states])
+            qd = np.array([s[1] for s in states])
+            driver = motors.clip(
+                stiffness * (position - q) + damping * (velocity - qd) + torque, qd
             )
-            torques = motors.torques(
-                step / steps,
-                np.array([s[0] for s in states]),
-                np.array([s[1] for s in states]),
-            )
+            applied += driver
             self._set_motors(
                 self.body,
                 self._model_indices,
                 pybullet.TORQUE_CONTROL,
-                forces=torques.tolist(),
-                physicsClientId=self._client_id,
+                forces=(driver - motors.viscous_friction * qd).tolist(),
+                physicsClientId=client,
             )
             self.step(base_force_world)
             if observer is not None:
                 observer(self, base_force_world)
+        self._motor_target = command.position.copy()
+        self.applied_torques = applied / steps
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step (``time_step`` [s]) with a force [N] on the base CoM.

@@ -35,6 +35,7 @@ from numpy.typing import NDArray
 
 from app.backends.base import InitialCondition
 from app.backends.physics_log import PhysicsLog
+from app.reality import DEFAULT_PROFILE
 from app.setup.build import build_robot_backend
 from app.setup.overrides import Overrides
 from planner.exceptions import RsgError
@@ -369,15 +370,21 @@ def planner_factory(description: RobotDescription):  # noqa: ANN201
 
 
 def build_placo_wpg_backend(  # noqa: ANN201
-    robot: str, overrides: Overrides = (), physics_log: PhysicsLog | None = None
+    robot: str,
+    overrides: Overrides = (),
+    physics_log: PhysicsLog | None = None,
+    reality: str = DEFAULT_PROFILE,
+    seed: int = 0,
 ):
     """PyBullet backend, configuration, initial condition and planner factory of placo-wpg.
 
     The backend, IK and configuration are the RSG's (:func:`app.setup.build.
-    build_robot_backend`, with ``overrides`` and ``physics_log``); the initial state is
-    placo's plan at t = 0.
+    build_robot_backend`, with ``overrides``, ``physics_log`` and the reality profile
+    ``reality`` drawn from ``seed``); the initial state is placo's plan at t = 0.
     """
-    backend, config, _ = build_robot_backend(robot, "rsg", overrides, physics_log=physics_log)
+    backend, config, _ = build_robot_backend(
+        robot, "rsg", overrides, physics_log=physics_log, reality=reality, seed=seed
+    )
     factory = planner_factory(backend.description)
     initial = factory(config).initial_condition()
     return backend, config, initial, factory

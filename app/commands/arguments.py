@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any, NoReturn, TypeVar
 
 from app.experiments.jobs import JobRun, check_workers
+from app.reality import DEFAULT_PROFILE, PROFILES, PROFILES_HELP
 from app.results.folder import MAX_PATH_LENGTH
 from app.scenarios import MAX_DURATION, parse_push
 from app.setup.build import check_robot_overrides
@@ -130,8 +131,11 @@ def out_argument(text: str) -> Path:
     return Path(text)
 
 
-def add_model_and_robot(parser: argparse.ArgumentParser, default_model: str) -> None:
-    """``--model`` and ``--robot``."""
+def add_model_and_robot(
+    parser: argparse.ArgumentParser, default_model: str, reality_seed: bool = False
+) -> None:
+    """``--model``, ``--robot`` and ``--reality`` (with ``--reality-seed`` when
+    ``reality_seed``: a command that runs once)."""
     parser.add_argument(
         "--model",
         choices=MODELS,
@@ -139,6 +143,42 @@ def add_model_and_robot(parser: argparse.ArgumentParser, default_model: str) -> 
         help=f"simulation backend (default: {default_model})",
     )
     add_robot_argument(parser)
+    add_reality_argument(parser, reality_seed)
+
+
+def add_reality_argument(parser: argparse.ArgumentParser, reality_seed: bool = False) -> None:
+    """``--reality`` (:mod:`app.reality`) and, when ``reality_seed``, ``--reality-seed``."""
+    parser.add_argument(
+        "--reality",
+        choices=PROFILES,
+        default=DEFAULT_PROFILE,
+        help=f"the full robot's sensor noise, control delay and model errors: {PROFILES_HELP} "
+        f"(default: {DEFAULT_PROFILE}; the LIPM ignores it)",
+    )
+    if reality_seed:
+        parser.add_argument(
+            "--reality-seed",
+            type=seed_argument("--reality-seed"),
+            default=0,
+            metavar="N",
+            help="seed of the --reality draw (noise, and with randomized the robot's errors) "
+            "(default: 0)",
+        )
+
+
+def seed_argument(name: str) -> Callable[[str], int]:
+    """argparse type of a seed option ``name``: an integer >= 0."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text.strip())
+        except ValueError:
+            value = -1
+        if value < 0:
+            raise argparse.ArgumentTypeError(f"{name}={text[:60]!r}: an integer >= 0")
+        return value
+
+    return parse
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:

@@ -9,6 +9,7 @@ from app.commands.arguments import (
     add_command,
     add_decimal,
     add_out_arguments,
+    add_reality_argument,
     add_set_argument,
 )
 from app.experiments.bench import (
@@ -36,6 +37,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg bench`` to the subcommands."""
     p = add_command(sub, "bench", HELP, DESCRIPTION)
     p.add_argument("--robot", default="g1", help="robot for the full-robot part (default g1)")
+    add_reality_argument(p)
     add_decimal(p, "--duration", 4.0, "full-robot walk [s] (4)")
     p.add_argument("--samples", type=int, default=1000, help="sampled step QPs (1000)")
     p.add_argument("--no-robot", action="store_true", help="skip the PyBullet part")
@@ -64,12 +66,15 @@ def run(args: argparse.Namespace) -> int:
     report: dict = {
         "units": "seconds per call; real_time_factor = simulated / wall time",
         "overrides": [f"{name}={value}" for name, value in overrides],
+        "reality": args.reality,
     }
     report.update(bench_rsg_ticks())
     report.update(bench_step_qp(args.samples))
     if not args.no_robot:
-        report.update(bench_robot(args.robot, args.duration, overrides=overrides))
-        report["placo_wpg"] = bench_placo_wpg(args.robot, args.duration, overrides)
+        report.update(
+            bench_robot(args.robot, args.duration, overrides=overrides, reality=args.reality)
+        )
+        report["placo_wpg"] = bench_placo_wpg(args.robot, args.duration, overrides, args.reality)
     table = format_bench(report)
     report["table"] = table
     try:

@@ -23,7 +23,7 @@ from app.results.replay import ReplayRecorder
 from app.results.run_files import write_results
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, describe_push, load_scenario
-from app.setup.build import build_backend, resolve_robot
+from app.setup.build import backend_reality, build_backend, resolve_robot
 from app.setup.overrides import check_overrides
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
@@ -64,9 +64,11 @@ examples:
   rsg run --model lipm --controller no-step --scenario walk --push 3:0,25 --out results/side
   rsg run --model lipm --scenario my_pushes.toml --out results/mine
   rsg run --model pybullet --controller placo-wpg --scenario walk --duration 4 --out results/wpg
+  rsg run --reality randomized --reality-seed 3 --scenario walk --out results/g1-real3
 
 outputs in --out (a folder with an earlier run's results is refused without --overwrite):
-  summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels
+  summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels,
+                   the reality profile and, on the full robot, its draw
   timeseries.csv   CoM, ZMP, hdot, stance foot, DCM error, V_u, s~, push force (SI units)
   fig6*.png        the paper's Fig. 6: top view, time since step, DCM error
   replay.npz       the run for the browser: rsg replay FOLDER
@@ -101,7 +103,7 @@ def verdict(result: RunResult) -> str:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg run`` to the subcommands."""
     p = add_command(sub, "run", HELP, DESCRIPTION, EPILOG)
-    add_model_and_robot(p, "pybullet")
+    add_model_and_robot(p, "pybullet", reality_seed=True)
     p.add_argument(
         "--controller",
         choices=(*CONTROLLERS, "placo-wpg"),
@@ -196,16 +198,28 @@ def run(args: argparse.Namespace) -> int:
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
         backend, config, initial, planner = build_placo_wpg_backend(
-            robot or DEFAULT_ROBOT, overrides, physics_log
+            robot or DEFAULT_ROBOT, overrides, physics_log, args.reality, args.reality_seed
         )
     else:
         backend, config, initial = build_backend(
-            args.model, robot, args.controller, args.paper_rules, overrides, physics_log
+            args.model,
+            robot,
+            args.controller,
+            args.paper_rules,
+            overrides,
+            physics_log,
+            args.reality,
+            args.reality_seed,
         )
     if overrides:
         print("with " + " ".join(f"--set {name}={value}" for name, value in overrides))
     recorder = ReplayRecorder()
     try:
+        reality = backend_reality(backend, args.reality, args.reality_seed)
+        if reality is not None:
+            print(reality.describe())
+        elif args.reality != "ideal":
+            print(f"reality {args.reality}: ignored on --model lipm (the LIPM stays ideal)")
         scaled, factor = scenario.scaled_to(backend.mass)
         if factor != 1.0:
             print(
@@ -231,6 +245,10 @@ def run(args: argparse.Namespace) -> int:
         ]
         if robot is not None:
             result.extra["robot"] = robot
+        result.extra["reality"] = args.reality
+        result.extra["reality_seed"] = args.reality_seed
+        if reality is not None:
+            result.extra["reality_draw"] = reality.as_dict()
         description = getattr(backend, "description", None)
         if args.model == "pybullet" and description is not None:
             # The physics model: these joints are welded at their standing angles.

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from app.backends.lipm import LipmBackend
+from app.reality import DEFAULT_PROFILE
 from app.runner import ClosedLoop
 from app.scenarios import BUILT_IN, Scenario
 from app.setup.overrides import Overrides
@@ -140,23 +141,32 @@ def bench_step_qp(samples: int = 500, seed: int = 0) -> dict:
 
 
 def bench_robot(
-    robot: str, duration: float, controller: str = "rsg", overrides: Overrides = ()
+    robot: str,
+    duration: float,
+    controller: str = "rsg",
+    overrides: Overrides = (),
+    reality: str = DEFAULT_PROFILE,
 ) -> dict:
     """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then).
 
     With ``controller="placo-wpg"`` the planner is the placo baseline, and its
     ticks are timed too (``rsg_tick``/``rsg_step_tick`` keys: without/with a step).
-    ``overrides``: ``--set`` assignments (for example ``locked_joints=none``).
+    ``overrides``: ``--set`` assignments (for example ``locked_joints=none``);
+    ``reality``: the robot's reality profile (:mod:`app.reality`), drawn from seed 0.
     """
     factory = None
     if controller == "placo-wpg":
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
-        backend, config, initial, factory = build_placo_wpg_backend(robot, overrides)
+        backend, config, initial, factory = build_placo_wpg_backend(
+            robot, overrides, reality=reality
+        )
     else:
         from app.setup.build import build_backend
 
-        backend, config, initial = build_backend("pybullet", robot, controller, overrides=overrides)
+        backend, config, initial = build_backend(
+            "pybullet", robot, controller, overrides=overrides, reality=reality
+        )
     ik_times: list[float] = []
     physics_times: list[float] = []
     tick_times: list[float] = []
@@ -208,9 +218,11 @@ def bench_robot(
     }
 
 
-def bench_placo_wpg(robot: str, duration: float, overrides: Overrides = ()) -> dict:
+def bench_placo_wpg(
+    robot: str, duration: float, overrides: Overrides = (), reality: str = DEFAULT_PROFILE
+) -> dict:
     """The same figures for the placo-wpg baseline (its planner ticks on the robot)."""
-    return bench_robot(robot, duration, "placo-wpg", overrides)
+    return bench_robot(robot, duration, "placo-wpg", overrides, reality)
 
 
 ROWS = (

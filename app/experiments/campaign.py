@@ -23,6 +23,13 @@ the same seed. In this order, each floored to a grid so that it is written exact
 Seeds (:data:`SEEDS`): ``dev`` (1) is for development and tuning; ``eval`` (2) is for
 reported figures only, never for choosing a parameter.
 
+Reality (``--reality``, :mod:`app.reality`): push i's runs on the full robot, every
+controller's, meet the robot drawn from :func:`push_seed` (seed s, index i), from a
+stream of its own (the pushes' draws are unchanged); each run's record holds its draw.
+The touchdowns the pushes are timed from are measured once per model and controller, on
+the campaign's reference robot, drawn from ``push_seed(s, REFERENCE_ROBOT)`` (an index no
+push has): with ``randomized`` a push's own robot may land a tick earlier or later.
+
 The twin: each push also runs on the LIPM with the same robot's planner
 (``--model lipm --robot NAME``: its mass, sole, gait and timing on the point mass,
 the same controller, and the ``--set`` values that apply there), with the same push
@@ -45,7 +52,8 @@ import numpy as np
 
 from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along, stance_offset_after
-from app.experiments.sweep import PLACO_WPG, PushExperiment, check_pushes
+from app.experiments.sweep import PLACO_WPG, PushExperiment, check_pushes, result_fields
+from app.reality import trial_seed
 from app.scenarios import MAX_IMPULSE
 from app.setup.build import build_backend
 from app.setup.overrides import Overrides, allowed_names
@@ -61,7 +69,7 @@ DEFAULT_IMPULSE = (5.0, 10.0)  # [N s] on REFERENCE_MASS
 SPEC_FILE = "campaign_spec.json"
 # Fields that change a run's result: a resumed campaign must agree on them.
 RESULT_FIELDS = ("model", "robot", "seed", "impulse", "duration", "cycle", "settle",
-                 "paper_rules", "fall_dcm_error", "overrides")  # fmt: skip
+                 "paper_rules", "fall_dcm_error", "overrides", "reality")  # fmt: skip
 
 
 def parse_seed(text: str) -> int:
@@ -263,14 +271,26 @@ def campaign_jobs(spec: CampaignSpec) -> list[CampaignJob]:
     ]
 
 
+#: The index of the campaign's reference robot, whose walk times the pushes: no push's
+#: (a campaign has at most 100000 pushes, indices 0 to 99999).
+REFERENCE_ROBOT = 100_000
+
+
+def push_seed(spec: CampaignSpec, index: int) -> int:
+    """Seed of the reality of push ``index``'s runs (:func:`app.reality.trial_seed` of the
+    campaign's seed and the index)."""
+    return trial_seed(spec.seed, index)
+
+
 def touchdowns(spec: CampaignSpec) -> dict[str, float]:
     """Time [s] of the touchdown of step ``cycle`` in the unpushed walk, per model
-    (``robot``, ``twin``) and controller: ``"robot|rsg"`` -> 3.1 on G1."""
+    (``robot``, ``twin``) and controller: ``"robot|rsg"`` -> 3.1 on G1 (on the reference
+    robot of ``spec``'s reality, the draw of :data:`REFERENCE_ROBOT`)."""
     found = {}
     for job in campaign_jobs(replace(spec, pushes=1)):
         on = spec.twin() if job.twin else spec
         if on is not None:
-            run = PushRun(on, job.controller)
+            run = PushRun(on, job.controller, push_seed(spec, REFERENCE_ROBOT))
             found[job.model_key] = run.touchdown(spec.cycle)
             run.backend.close()
     return found
@@ -286,12 +306,16 @@ def run_campaign_job(
     if on is None:
         raise ParameterError("twin", job.key, "a campaign with a twin (--model pybullet)")
     pushed = push.push(touchdown)
-    result = PushRun(on, job.controller).run(pushed, pushed.time + spec.settle)
+    seed = push_seed(spec, push.index)
+    trial = PushRun(on, job.controller, seed)
+    result = trial.run(pushed, pushed.time + spec.settle)
     return {
         "key": job.key,
         **asdict(job),
         "touchdown": touchdown,
         "push_time": pushed.time,
+        "reality_seed": seed,
+        "reality": trial.reality.as_dict() if trial.reality is not None else None,
         **describe(result, pushed, job.controller),
         "stance_offset_y": (
             None if job.controller == PLACO_WPG else stance_offset_after(result, pushed.time)
@@ -317,7 +341,8 @@ def run_campaign(spec: CampaignSpec, run: JobRun) -> tuple[list[CampaignPush], d
     arguments = {
         job.key: (spec, pushes[job.index], job, times[job.model_key]) for job in campaign_jobs(spec)
     }
+    fields = result_fields(RESULT_FIELDS, spec)
     records = run_resumable(
-        _run_campaign_job_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, run, "pushes", "runs"
+        _run_campaign_job_args, arguments, spec, fields, SPEC_FILE, run, "pushes", "runs"
     )
     return pushes, records

@@ -29,6 +29,9 @@ DEFINITIONS = {
     "sole in single support after the push start [m] (null for placo-wpg): on the twin, "
     "how far the plan swings the CoM over the stance leg",
     "twin": "the same push on the LIPM with the robot's planner (--model lipm --robot NAME)",
+    "reality": "sensor noise, control delay and model errors of the full robot "
+    "(--reality, app/reality.py); a push's row holds the draw all its robot runs met "
+    "(null on the LIPM, which stays ideal)",
     "adjusted_step_ratio": "sum of the robot's adjusted steps / the twin's, over all pushes "
     "(_both: over the pushes both recovered)",
 }
@@ -43,7 +46,8 @@ def push_argument(push: CampaignPush, start: float) -> str:
 def push_rows(spec: CampaignSpec, pushes: list[CampaignPush], records: dict[str, dict]) -> list:
     """One row per push: the draw, its velocity change, the ``rsg run --push`` argument
     of the first controller's run and each controller's figures on the robot (``runs``)
-    and on the twin (``twins``; on the LIPM, the runs)."""
+    and on the twin (``twins``; on the LIPM, the runs), and the reality drawn for its
+    runs on the full robot (``reality``, :meth:`app.reality.RealityDraw.as_dict`)."""
     twin = spec.twin()
     rows = []
     for push in pushes:
@@ -54,8 +58,12 @@ def push_rows(spec: CampaignSpec, pushes: list[CampaignPush], records: dict[str,
             names = twin.controllers if twin is not None else ()
             twins = {c: _figures(records, CampaignJob(push.index, c, twin=True)) for c in names}
         first = runs[spec.controllers[0]]["push_time"]
+        # The robot every controller met on this push (None on the LIPM, or a folder of
+        # before the reality profiles).
+        reality = records[CampaignJob(push.index, spec.controllers[0]).key].get("reality")
         rows.append({**asdict(push), "velocity_change": round(push.impulse / spec.mass, 4),
-                     "push": push_argument(push, first), "runs": runs, "twins": twins})  # fmt: skip
+                     "push": push_argument(push, first), "reality": reality, "runs": runs,
+                     "twins": twins})  # fmt: skip
     return rows
 
 
@@ -112,6 +120,7 @@ def write_campaign(
     document = {
         "spec": asdict(spec),
         "seed": seed_name(spec.seed),
+        "reality": spec.reality,
         "mass": spec.mass,
         "units": {
             "direction_deg": "deg",
@@ -158,6 +167,8 @@ def format_summary(spec: CampaignSpec, summary: dict) -> str:
     """The summary as a table: outcomes, the twin's recoveries and the step ratio."""
     low, high = spec.impulse or (0.0, 0.0)
     where = f"{spec.robot or 'the paper point mass'} on {spec.model}"
+    if spec.model == "pybullet":
+        where += f" (reality {spec.reality})"
     lines = [
         f"{spec.pushes} pushes, seed {seed_name(spec.seed)}, {where}: {low:g}-{high:g} N s over "
         f"{spec.duration[0]:g}-{spec.duration[1]:g} s, any direction, start uniform over cycle "

@@ -16,6 +16,10 @@ timing and leg reach). A fall above it is a limit of the robot's parameters, not
 controller; the printed grid writes those outcomes in capitals.
 
 Counts over the grid compare controllers without the monotonicity assumption.
+
+Reality (``--reality``, :mod:`app.reality`): each push (phase, direction, impulse) meets
+its own robot, the same for every controller, drawn from
+:func:`app.experiments.sweep.push_reality_seed`; its record holds the seed.
 """
 
 from __future__ import annotations
@@ -35,7 +39,7 @@ from app.experiments.outcome import (
     describe,
     impulse_along,
 )
-from app.experiments.sweep import PushExperiment, check_pushes
+from app.experiments.sweep import PushExperiment, check_pushes, push_reality_seed
 from app.experiments.trial import push_timing
 from planner.exceptions import ParameterError, RsgError
 from planner.types import Push
@@ -116,7 +120,8 @@ def all_grid_jobs(spec: GridSpec) -> list[GridJob]:
 def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
     """One push; returns its JSON-ready record."""
     started = time.perf_counter()
-    trial = PushRun(spec, job.controller)
+    seed = push_reality_seed(job.direction_deg, job.phase, job.impulse)
+    trial = PushRun(spec, job.controller, seed)
     t_push, sigma, since = push_timing(trial.config, spec.cycle, job.phase)
     angle = math.radians(job.direction_deg)
     bound = impulse_bound(trial.config, angle, sigma, since, spec.duration)
@@ -128,6 +133,7 @@ def run_grid_job(spec: GridSpec, job: GridJob) -> dict:
         "push_time": t_push,
         "stance": "left" if sigma > 0 else "right",
         "capture_bound": bound,
+        "reality_seed": seed,
         "wall_time": time.perf_counter() - started,
     }
 

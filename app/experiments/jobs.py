@@ -39,6 +39,9 @@ JOBS_FILE = "jobs.jsonl"
 MAX_RAY_WORKERS = 1024
 PARENT_POLL_PERIOD = 0.5  # [s] how often a worker checks that its parent still runs
 START_OVER = "use another --out, or add --overwrite to start over"
+#: Result-defining fields added to the specifications later -> the value the runs stored
+#: before had (``reality``: the full robot ran ideal before the profiles existed).
+FIELDS_ADDED = {"reality": "ideal"}
 
 
 class JobProgress:
@@ -124,8 +127,8 @@ def load_finished(
         old = _read_spec(spec_path, type(spec))
         # Tuples as JSON lists, as stored.
         new, defaults = (json.loads(json.dumps(asdict(s))) for s in (spec, type(spec)()))
-        for name in fields:  # a field missing from an older spec had its default
-            stored = old.get(name, defaults[name])
+        for name in fields:  # a field missing from an older spec had its default then
+            stored = old.get(name, FIELDS_ADDED.get(name, defaults[name]))
             if stored != new[name]:
                 raise ParameterError(
                     f"--out {out} ({name})",

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.outcome import PushRun, describe, impulse_along
-from app.experiments.sweep import RESULT_FIELDS, SPEC_FILE, SweepSpec
+from app.experiments.sweep import RESULT_FIELDS, SPEC_FILE, SweepSpec, result_fields
 from planner.exceptions import RsgError
 from planner.types import Push
 
@@ -39,7 +39,8 @@ def run_check(spec: SweepSpec, record: dict, fraction: float) -> dict:
     started = time.perf_counter()
     impulse = fraction * record["impulse"]
     push = Push(record["push_time"], impulse_along(record["direction_deg"], impulse), spec.duration)
-    result = PushRun(spec, record["controller"]).run(push, push.time + spec.settle)
+    seed = record.get("reality_seed", 0)  # the bisection's robot (0: a folder of before)
+    result = PushRun(spec, record["controller"], seed).run(push, push.time + spec.settle)
     figures = describe(result, push, record["controller"])
     passed = figures["outcome"] == "recovered" or (
         spec.criterion == "no-fall" and figures["outcome"] != "fell"
@@ -72,8 +73,9 @@ def run_monotonicity(spec: SweepSpec, records: list[dict], run: JobRun) -> dict:
         for fraction in FRACTIONS
     }
     into = replace(run, out=run.out / FOLDER)
+    fields = result_fields(RESULT_FIELDS, spec)
     done = run_resumable(
-        _run_check_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, into, "monotonicity", "runs"
+        _run_check_args, arguments, spec, fields, SPEC_FILE, into, "monotonicity", "runs"
     )
     return summarize(spec, [done[key] for key in arguments])
 

@@ -23,8 +23,10 @@ import numpy as np
 
 from app.experiments.sweep import PLACO_WPG, PushExperiment, build_controller
 from app.experiments.trial import measured_touchdown
+from app.reality import RealityDraw
 from app.runner import RunResult
 from app.scenarios import Scenario
+from app.setup.build import backend_reality
 from planner.types import Push
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -62,15 +64,22 @@ def settle_steps(result: RunResult, start: float) -> int | None:
 
 
 class PushRun:
-    """``controller`` built on ``spec``'s model and robot, for one run with one push.
+    """``controller`` built on ``spec``'s model and robot, for one run with one push; the
+    full robot with ``spec``'s reality drawn from ``seed``.
 
     Attributes:
         config: The planner configuration (push timing and bounds are read from it
             before :meth:`run`).
+        reality: The draw the full robot's backend applies (None on the LIPM).
     """
 
-    def __init__(self, spec: PushExperiment, controller: str) -> None:
-        self.backend, self.config, self.initial, self.planner = build_controller(spec, controller)
+    def __init__(self, spec: PushExperiment, controller: str, seed: int = 0) -> None:
+        self.backend, self.config, self.initial, self.planner = build_controller(
+            spec, controller, seed
+        )
+        self.reality: RealityDraw | None = None
+        if spec.model == "pybullet":
+            self.reality = backend_reality(self.backend, spec.reality, seed)
 
     def touchdown(self, cycle: int) -> float:
         """Time [s] at which step ``cycle`` lands in the unpushed walk

@@ -46,6 +46,7 @@ from pathlib import Path
 from app.experiments.campaign import gait_config, robot_mass
 from app.experiments.jobs import JobRun
 from app.experiments.sweep import Job, SweepSpec, run_sweep
+from app.reality import DEFAULT_PROFILE
 from app.setup.build import resolve_robot
 from app.setup.overrides import Overrides
 from planner.exceptions import ParameterError, RsgError
@@ -73,7 +74,7 @@ class ProtocolSpec:
     """What the protocol runs.
 
     Attributes:
-        model, robot, controllers, paper_rules, overrides: As the sweep's.
+        model, robot, controllers, paper_rules, overrides, reality: As the sweep's.
         cycle: Walking cycle of the pushes (even: left stance, as IHMC's tests).
         settle: Simulated time after the push start [s].
         tolerance: Bisection tolerance on the fraction of m g [-].
@@ -89,6 +90,7 @@ class ProtocolSpec:
     criterion: str = "recovered"
     paper_rules: bool = False
     overrides: Overrides = ()
+    reality: str = DEFAULT_PROFILE
 
     def __post_init__(self) -> None:
         if not (isinstance(self.cycle, int) and 2 <= self.cycle <= 20 and self.cycle % 2 == 0):
@@ -116,6 +118,7 @@ class ProtocolSpec:
             paper_rules=self.paper_rules,
             overrides=self.overrides,
             timing="touchdown",
+            reality=self.reality,
         )
 
 

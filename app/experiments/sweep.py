@@ -33,6 +33,7 @@ from app.experiments.bisection import bisect_threshold
 from app.experiments.capture_bound import impulse_bound
 from app.experiments.jobs import JobRun, run_resumable
 from app.experiments.trial import SettledTrial, measured_touchdown, push_timing
+from app.reality import DEFAULT_PROFILE, check_profile, trial_seed
 from app.scenarios import Scenario
 from app.setup.build import resolve_robot
 from app.setup.overrides import Overrides, check_overrides
@@ -60,6 +61,9 @@ class PushExperiment:
             of many pushes (up to ~1 m); by default only its leg-reach rule decides (CoM
             within 0.6 m of the stance ankle).
         overrides: ``--set`` (name, value) pairs (:mod:`app.setup.overrides`).
+        reality: Profile of :mod:`app.reality` (``--reality``) of the full robot; each
+            trial draws its own from its seed (:func:`push_reality_seed`, the campaign's
+            :func:`app.experiments.campaign.push_seed`); ignored on ``lipm``.
     """
 
     model: str = "lipm"
@@ -68,9 +72,34 @@ class PushExperiment:
     paper_rules: bool = False
     fall_dcm_error: float = 2.0
     overrides: Overrides = ()
+    reality: str = DEFAULT_PROFILE
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "robot", resolve_robot(self.model, self.robot))
+        check_profile(self.reality)
+
+
+#: Seed of the sweep's and the grid's reality draws (they have no seed of their own).
+REALITY_SEED = 0
+#: Digits of a direction [deg], phase [-] or impulse [N s] in a trial's key: the job keys'.
+KEY_SCALE = 10_000
+
+
+def push_reality_seed(direction_deg: float, phase: float, impulse: float | None = None) -> int:
+    """Seed of the reality of the push trial at ``direction_deg``, ``phase`` (and
+    ``impulse`` [N s], for a grid's single runs; a sweep's bisection is one trial over its
+    impulses): :func:`app.reality.trial_seed` of :data:`REALITY_SEED` and the values to 4
+    decimals. Every controller meets the same robot on the same push."""
+    keys = [round(direction_deg * KEY_SCALE), round(phase * KEY_SCALE)]
+    if impulse is not None:
+        keys.append(round(impulse * KEY_SCALE))
+    return trial_seed(REALITY_SEED, *keys)
+
+
+def result_fields(fields: tuple[str, ...], spec: PushExperiment) -> tuple[str, ...]:
+    """``fields`` that change a result of ``spec``: without ``reality`` on the LIPM (which
+    ignores it), so an LIPM folder resumes whatever its profile."""
+    return fields if spec.model == "pybullet" else tuple(f for f in fields if f != "reality")
 
 
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
@@ -93,7 +122,7 @@ RECORD_FIELDS: dict[str, type | tuple[type, ...]] = {
 # Fields that change a job's result: a resumed sweep must agree on them.
 RESULT_FIELDS = ("model", "robot", "duration", "cycle", "settle", "tolerance", "bracket",
                  "qp_solver", "criterion", "fall_dcm_error", "paper_rules",
-                 "overrides", "timing")  # fmt: skip
+                 "overrides", "timing", "reality")  # fmt: skip
 
 
 def check_pushes(
@@ -212,27 +241,31 @@ class Job:
         return f"{self.controller}|{math.degrees(self.angle):.4f}|{self.phase:.4f}"
 
 
-def _build(spec: SweepSpec, controller: str):  # noqa: ANN202
+def _build(spec: SweepSpec, controller: str, seed: int = 0):  # noqa: ANN202
     """Backend, configuration and initial condition (see :func:`build_controller`)."""
-    return build_controller(spec, controller)[:3]
+    return build_controller(spec, controller, seed)[:3]
 
 
-def build_controller(spec: PushExperiment, controller: str):  # noqa: ANN202
+def build_controller(spec: PushExperiment, controller: str, seed: int = 0):  # noqa: ANN202
     """Backend, configuration, initial condition and planner factory (None: the RSG's)
-    of ``controller`` on ``spec``'s model and robot."""
+    of ``controller`` on ``spec``'s model and robot, the full robot with ``spec``'s
+    reality drawn from ``seed``."""
     if controller == PLACO_WPG:
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
-        return build_placo_wpg_backend(spec.robot or DEFAULT_ROBOT, spec.overrides)
-    return (*_build_rsg(spec, controller), None)
+        return build_placo_wpg_backend(
+            spec.robot or DEFAULT_ROBOT, spec.overrides, reality=spec.reality, seed=seed
+        )
+    return (*_build_rsg(spec, controller, seed), None)
 
 
-def _build_rsg(spec: PushExperiment, controller: str):  # noqa: ANN202
+def _build_rsg(spec: PushExperiment, controller: str, seed: int = 0):  # noqa: ANN202
     from app.setup.build import build_backend
 
     backend, config, initial = build_backend(
-        spec.model, spec.robot, controller, spec.paper_rules, spec.overrides
-    )
+        spec.model, spec.robot, controller, spec.paper_rules, spec.overrides,
+        reality=spec.reality, seed=seed,
+    )  # fmt: skip
     if spec.model == "lipm":
         from app.backends.lipm import LipmBackend
 
@@ -245,7 +278,8 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
     from app.runner import run_closed_loop
 
     started = time.perf_counter()
-    backend, config, initial, planner = build_controller(spec, job.controller)
+    seed = push_reality_seed(math.degrees(job.angle), job.phase)
+    backend, config, initial, planner = build_controller(spec, job.controller, seed)
     runner = getattr(backend, "run_closed_loop", None) or run_closed_loop
     options = {} if planner is None else {"planner": planner}
     early = spec.model == "lipm" and spec.criterion == "recovered"
@@ -288,6 +322,7 @@ def run_job(spec: SweepSpec, job: Job) -> dict:
         "bound": bound,
         "ratio": found.passed / bound if bound > 0 else math.nan,
         "mass": config.model.mass,
+        "reality_seed": seed,
         "runs": len(found.evaluations),
         "evaluations": found.evaluations,
         "wall_time": time.perf_counter() - started,
@@ -337,7 +372,8 @@ def run_sweep(
     """
     jobs = all_jobs(spec) if jobs is None else jobs
     arguments = {job.key: (spec, job) for job in jobs}
+    fields = result_fields(RESULT_FIELDS, spec)
     finished = run_resumable(
-        _run_job_args, arguments, spec, RESULT_FIELDS, SPEC_FILE, run, label, parse=_parse_record
+        _run_job_args, arguments, spec, fields, SPEC_FILE, run, label, parse=_parse_record
     )
     return [finished[job.key] for job in jobs]

@@ -8,7 +8,8 @@ recover is the one to look at; a fall before a mere "not recovered"):
 - sweep: per job, the run at the smallest impulse that failed (the bisection's
   upper end), for jobs that found one.
 
-Runs are deterministic, so each chosen run is simulated again once with a
+Runs are deterministic (the full robot's reality is drawn again from the record's
+``reality_seed``), so each chosen run is simulated again once with a
 :class:`app.results.replay.ReplayRecorder` (a few runs, against the hundreds of the sweep)
 and written to ``OUT/replays/<controller>-<direction>deg-phase<p>-<impulse>Ns/``:
 ``replay.npz`` and ``summary.json``.
@@ -30,6 +31,7 @@ from app.results.replay import ReplayRecorder
 from app.results.run_files import summary_of
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
+from app.setup.build import backend_reality
 from planner.exceptions import RsgError
 from planner.types import Push
 
@@ -126,7 +128,8 @@ def write_worst_replays(spec: Any, runs: list[dict], out: Path) -> list[dict]:
     """
     written = []
     for record in runs:
-        backend, config, initial, planner = build_controller(spec, record["controller"])
+        seed = record.get("reality_seed", 0)  # the run's robot (0: a folder of before)
+        backend, config, initial, planner = build_controller(spec, record["controller"], seed)
         options = {} if planner is None else {"planner": planner}
         recorder = ReplayRecorder()
         try:
@@ -141,6 +144,11 @@ def write_worst_replays(spec: Any, runs: list[dict], out: Path) -> list[dict]:
             )
         finally:
             backend.close()
+        result.extra["reality"] = spec.reality
+        result.extra["reality_seed"] = seed
+        draw = backend_reality(backend, spec.reality, seed) if spec.model == "pybullet" else None
+        if draw is not None:
+            result.extra["reality_draw"] = draw.as_dict()
         folder = out / REPLAYS_DIR / replay_name(record)
         recorder.write(result, record["controller"], spec.robot, folder)
         try:

@@ -7,6 +7,7 @@ from dataclasses import replace
 from app.backends.base import Backend, InitialCondition
 from app.backends.lipm import LipmBackend
 from app.backends.physics_log import PhysicsLog
+from app.reality import DEFAULT_PROFILE, RealityDraw, check_profile, robot_reality
 from app.runner import walking_start
 from app.setup.overrides import (
     Overrides,
@@ -40,6 +41,8 @@ def build_backend(
     paper: bool = False,
     overrides: Overrides = (),
     physics_log: PhysicsLog | None = None,
+    reality: str = DEFAULT_PROFILE,
+    seed: int = 0,
 ) -> tuple[Backend, PlannerConfig, InitialCondition]:
     """The backend for ``model`` and the planner configuration that fits it.
 
@@ -52,12 +55,16 @@ def build_backend(
         overrides: ``--set`` pairs (:mod:`app.setup.overrides`); RSG parameters among
             them are applied after ``paper``.
         physics_log: Records every physics step of a ``pybullet`` run (None: nothing).
+        reality: Profile of :mod:`app.reality` (``--reality``); on ``lipm`` checked and
+            ignored (the LIPM stays ideal).
+        seed: Seed of the reality's draw (:func:`robot_reality`).
 
     Raises:
-        ParameterError: Unknown model or robot, or a bad override.
+        ParameterError: Unknown model, robot or reality profile, or a bad override.
     """
     if model not in ("lipm", "pybullet"):
         raise ParameterError("--model", model, "lipm or pybullet")
+    check_profile(reality)
     check_overrides(overrides, model, robot, controller, paper)
     if model == "lipm":
         if robot is None:
@@ -72,7 +79,7 @@ def build_backend(
         return LipmBackend(config.model), config, walking_start(config)
     if model == "pybullet":
         return build_robot_backend(
-            robot or DEFAULT_ROBOT, controller, overrides, paper, physics_log
+            robot or DEFAULT_ROBOT, controller, overrides, paper, physics_log, reality, seed
         )
     raise ParameterError("--model", model, "lipm or pybullet")
 
@@ -99,20 +106,24 @@ def build_robot_backend(  # noqa: ANN201
     overrides: Overrides = (),
     paper: bool = False,
     physics_log: PhysicsLog | None = None,
+    reality: str = DEFAULT_PROFILE,
+    seed: int = 0,
 ):
     """PyBullet backend, planner configuration and walking start for ``robot``
     (a registry name or a description), with ``overrides`` (``--set``; RSG
     parameters are applied to the configuration, after the paper's rules when
     ``paper``, :func:`app.setup.paper_rules.paper_rules`). The backend's ``description``
-    is the one with the overrides; ``physics_log`` records every physics step.
+    is the one with the overrides; ``physics_log`` records every physics step; the
+    backend applies the reality ``reality`` drawn from ``seed`` (:func:`robot_reality`).
 
     Raises:
-        ParameterError: Unknown robot, or a bad override.
+        ParameterError: Unknown robot or reality profile, or a bad override.
     """
     # PyBullet and placo load only for full-robot runs.
     from app.backends.pybullet import PyBulletBackend
     from kinematics.swing_foot import SwingTiming
 
+    check_profile(reality)
     check_overrides(overrides, "pybullet", robot, controller, paper)
     description, parsed = robot_with_overrides(robot, overrides)
     config = planner_config_for(description, description.total_mass, controller)
@@ -124,10 +135,25 @@ def build_robot_backend(  # noqa: ANN201
         config.rsg.swing_preparation_time,
         config.gait.step_duration,
     )
-    backend = PyBulletBackend(description, timing, physics_log)
+    draw = robot_reality(description, reality, seed)
+    backend = PyBulletBackend(description, timing, physics_log, reality=draw)
     config = replace(config, model=replace(config.model, mass=backend.mass))
     initial: InitialCondition = walking_start(config)
     return backend, config, initial
+
+
+def backend_reality(backend: object, profile: str, seed: int) -> RealityDraw | None:
+    """The reality a backend built with ``profile`` and ``seed`` applies: its own
+    ``reality`` when it has one, else drawn again from its description
+    (:func:`robot_reality`, the same draw); None for a backend without a description
+    (the LIPM, which ignores the profile)."""
+    own = getattr(backend, "reality", None)
+    if isinstance(own, RealityDraw):
+        return own
+    description = getattr(backend, "description", None)
+    if isinstance(description, RobotDescription):
+        return robot_reality(description, profile, seed)
+    return None
 
 
 def check_robot_overrides(robot: str | None, overrides: Overrides) -> None:

@@ -12,7 +12,7 @@ A name is looked up in this order:
    ``filter_time_constant``, ``angular_momentum_rate_max``, ``com_height``, ...);
 2. an option of the PyBullet backend: the whole-body stabilizer's
    (:class:`app.stabilizer.config.StabilizerConfig`: ``landing_depth``,
-   ``flywheel_momentum``, ``estimator``, ...) and ``control_period``;
+   ``flywheel_momentum``, ...) and ``control_period``;
 3. a parameter of the RSG (:class:`planner.parameters.RsgParameters`) that the
    description does not set (``crossing_margin``, ``step_decrease_margin``,
    ``push_hold_time``, ...).
@@ -24,8 +24,7 @@ mass) the description fields its planner reads and the RSG parameters of 3.
 RSG parameters are applied after ``--paper-rules``, so ``--set`` wins over it.
 
 Values are numbers, ``true``/``false``, two comma-separated numbers for a pair
-(``step_max=0.35,0.4``), ``none`` where the option allows it, or a word for a
-string option (``estimator=odometry``), or comma-separated joint names
+(``step_max=0.35,0.4``), ``none`` where the option allows it, or comma-separated joint names
 (``locked_joints=none`` actuates every joint). Numbers are ASCII decimals (no nan,
 inf, hex or ``_``). Each parameter has a range, defined where the parameter is (the
 planner's ``planner.parameters.RANGES``, the description, the backend's

@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
-from app.stabilizer.estimator import SOURCES
 from planner.exceptions import ParameterError
 
 
@@ -14,9 +13,6 @@ class StabilizerConfig:
     """Options of :class:`app.stabilizer.controller.WholeBodyController` (units in brackets).
 
     Attributes:
-        estimator: Where the floating base's position and velocity come from:
-            ``"truth"`` (the simulator) or ``"odometry"`` (leg odometry from the stance
-            sole, encoders and IMU, what a real G1 has).
         landing_depth: How far below the ground the swing sole aims at the planned
             landing time [m], so it touches down by then rather than after.
         friction: Coulomb coefficient of the wrench distribution's contacts [-].
@@ -33,7 +29,6 @@ class StabilizerConfig:
             (docs/notes/2026-12-06-height-loop.md).
     """
 
-    estimator: str = "truth"
     landing_depth: float = 0.005
     friction: float = 0.7
     flywheel_momentum: float = 2.0
@@ -42,8 +37,6 @@ class StabilizerConfig:
     height_frequency: float = 10.0
 
     def __post_init__(self) -> None:
-        if self.estimator not in SOURCES:
-            raise ParameterError("estimator", self.estimator, " or ".join(SOURCES))
         for name, (low, high) in RANGES.items():
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int | float):

@@ -2,7 +2,9 @@
 
     measure -> (plan: the RSG, outside) -> swing foot -> stabilize -> IK -> actuate
 
-* measure: the state estimate (:mod:`.estimator`) from the measurement record;
+* measure: the state estimate (:mod:`.estimator`) from what the robot senses, and each
+  foot's load: its force sensor's where it has one, else the joint torques' through a
+  momentum observer (:mod:`.contact_observer`);
 * swing foot: the re-targetable swing trajectory and the landing rules (:mod:`.landing`);
   the swing sole's IK target is corrected for the real body's tilt on its stance ankle,
   and the new stance sole's is continuous at a step
@@ -13,8 +15,8 @@
   (:mod:`.wrench_distribution`);
 * IK: placo's whole-body IK, with the upper body as a flywheel for hdot
   (:mod:`kinematics.upper_body`);
-* actuate: per joint a target, stiffness, damping and the feed-forward torque from
-  inverse dynamics of the planned motion with the planned contact wrenches.
+* actuate: per joint a target, stiffness, damping and the feed-forward torque from the
+  floating-base inverse dynamics of the planned motion with the planned contact wrenches.
 
 The design, loop by loop, with its references and measurements: docs/full-robot.md.
 """
@@ -27,8 +29,10 @@ from numpy.typing import NDArray
 from app.lowlevel import JointCommand, RobotMeasurement
 from app.stabilizer import centroidal
 from app.stabilizer.config import StabilizerConfig
+from app.stabilizer.contact_observer import ContactForceObserver
 from app.stabilizer.estimator import RobotState, StateEstimator
 from app.stabilizer.landing import Landing
+from app.stabilizer.lipm_filter import LipmFilter
 from app.stabilizer.wrench_distribution import (
     ContactLimits,
     FootContact,
@@ -58,6 +62,16 @@ SWING_SPEED = 3.0  # [m/s] bound on the swing sole's speed: a catching step's fo
 # up to 0.6 m with 0.2-0.3 s left, which at 2 m/s lands late (docs/notes/2026-12-06-swing-speed.md)
 SWING_CORRECTION_TIME = 0.05  # [s] low-pass of the swing sole's measured offset (impacts)
 SWING_DESCENT_SLOPE = 0.5  # [-] the swing sole stays this high per metre still to go
+# [rad/s] the planned speed over which the friction compensation's sign turns
+FRICTION_SPEED = 0.05
+# The CoM filter's noise (:mod:`.lipm_filter`): the pendulum's error as acceleration
+# [m/s^2] (a 1 cm CoP error is 0.13 m/s^2; angular momentum and pushes more), the
+# kinematic CoM's error [m] and its velocity's [m/s] (joint velocity noise, impacts).
+LIPM_PROCESS_NOISE = 1.0
+COM_POSITION_NOISE = 0.003
+COM_VELOCITY_NOISE = 0.05
+# [1/s] the contact observer's low-pass: a touchdown seen within about 1/K = 20 ms
+OBSERVER_BANDWIDTH = 50.0
 
 
 class WholeBodyController:
@@ -95,12 +109,18 @@ class WholeBodyController:
         self.model = RobotModel(description)
         self.mass = self.model.mass
         self.lipm = LipmModel(mass=self.mass, com_height=description.pendulum_height)
-        self.estimator = StateEstimator(self.model, config.estimator)
+        self.estimator = StateEstimator(self.model, np.asarray(description.imu_position))
         flywheel = config.flywheel_momentum > 0.0 and bool(description.upper_body_joints)
         self.ik = WholeBodyIK(description, upper_body=flywheel)
         self._ik_order = np.array([self.ik.joint_names.index(n) for n in self.model.joint_names])
         legs = leg_joints(self.ik.robot.model)
         self._legs = {foot: self.model.index_of(legs[foot]) for foot in ("left", "right")}
+        self.com_filter = LipmFilter(
+            self.lipm.omega, LIPM_PROCESS_NOISE, COM_POSITION_NOISE, COM_VELOCITY_NOISE
+        )
+        self.observer = None
+        if not description.foot_force_sensors:
+            self.observer = ContactForceObserver(self.model, self._legs, OBSERVER_BANDWIDTH)
         self.flywheel = None
         if flywheel:
             self.flywheel = UpperBodyFlywheel(
@@ -126,6 +146,11 @@ class WholeBodyController:
             ankle_torque=self.model.ankle_effort_limits(),
         )
         self.stiffness, self.damping = joint_impedance(self.model, description)
+        motors = [description.motors.get(name) for name in self.model.joint_names]
+        self._static_friction = np.array([0.0 if m is None else m.static_friction for m in motors])
+        self._viscous_friction = np.array(
+            [0.0 if m is None else m.viscous_friction for m in motors]
+        )
         self._ankle_height = -float(description.sole_offset[2])
         self.expected_contact_force = np.zeros(self.model.nv)
         self.state: RobotState | None = None
@@ -157,6 +182,11 @@ class WholeBodyController:
         self.failure: str | None = None
         self._contacts: list[FootContact] = []
         self._landed: set[Foot] = {"left", "right"}  # supports that touched down since planned
+        self.loads: dict[str, float] = {}  # [N] each foot's estimated normal force
+        self._start: dict[Foot, NDArray[np.float64]] | None = None  # soles at reset [m]
+        self._observed_time: float | None = None
+        self._filtered_time: float | None = None
+        self._pivot = np.array(com_xy, dtype=float)  # [m] the pivot of the last tick
 
     def reset(
         self,
@@ -170,7 +200,8 @@ class WholeBodyController:
             The IK's joint angles [rad] in the model's joint order.
         """
         self._reset_state(np.asarray(com_xy, float))
-        self.estimator.reset()
+        self._start = {foot: np.asarray(pose[:3, 3], float) for foot, pose in soles.items()}
+        self.com_filter.reset()
         self._stance = stance
         q = self.ik.reset(soles["left"], soles["right"], com_xy)[self._ik_order]
         self.swing.start(soles[other_foot(stance)][:2, 3])
@@ -194,6 +225,7 @@ class WholeBodyController:
         self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
         # stabilize: the net force holds the IK's CoM height
         pivot = centroidal.pivot(command.zmp, command.angular_momentum_rate, self.mass)
+        self._pivot = pivot
         lift = centroidal.height_acceleration(
             self.config.height_frequency,
             self.ik.com_z_target(soles["left"], soles["right"]) - state.com[2],
@@ -219,9 +251,9 @@ class WholeBodyController:
         self._ik_soles = {foot: pose[:2, 3].copy() for foot, pose in soles.items()}
         q = self._solve_ik(command, com_target, soles)
         # actuate: feed-forward torques for the contact wrenches the feet are given
-        feet, wrenches = self._contact_wrenches(command, measurement, force)
-        torque = self._feedforward(feet, wrenches)
+        feet, wrenches = self._contact_wrenches(command, force)
         velocity = (q - self._targets[0]) / dt
+        torque = self._feedforward(feet, wrenches) + self._friction(velocity)
         self._targets = (q, self._targets[0])
         return JointCommand(q, velocity, self.stiffness, self.damping, torque)
 
@@ -366,7 +398,7 @@ class WholeBodyController:
         return q
 
     def _contact_wrenches(
-        self, command: PlannerOutput, measurement: RobotMeasurement, force: NDArray[np.float64]
+        self, command: PlannerOutput, force: NDArray[np.float64]
     ) -> tuple[list[Foot], list[NDArray[np.float64]]]:
         """The planned supports on the ground (else the feet that touch it; in the air,
         the stance foot) and the wrench each is given.
@@ -377,9 +409,7 @@ class WholeBodyController:
         crossing step) keeps its wrench, so its leg's feed-forward presses it down."""
         threshold = CONTACT_LOAD * self.mass * GRAVITY
         planned: list[Foot] = ["left", "right"] if command.double_support else [command.stance.foot]
-        touching: list[Foot] = [
-            f for f in ("left", "right") if measurement.normal_force(f) > threshold
-        ]
+        touching: list[Foot] = [f for f in ("left", "right") if self.load(f) > threshold]
         self._landed.intersection_update(planned)  # a swinging foot has to touch down again
         self._landed.update(f for f in touching if f in planned)
         on_ground = [
@@ -406,7 +436,7 @@ class WholeBodyController:
         # A foot carrying less than planned (a bounce, a heel up) is not tipped onto its
         # edge by its ankle's feed-forward: its CoP stays on the sole at the force it carries.
         wrenches = [
-            within_sole_at_force(contact, wrench, measurement.normal_force(foot), self.limits.sole)
+            within_sole_at_force(contact, wrench, self.load(foot), self.limits.sole)
             for foot, contact, wrench in zip(feet, contacts, wrenches, strict=True)
         ]
         return feet, wrenches
@@ -414,19 +444,54 @@ class WholeBodyController:
     def _feedforward(
         self, feet: list[Foot], wrenches: list[NDArray[np.float64]]
     ) -> NDArray[np.float64]:
-        """tau_ff = M a + h - J^T f [N m] for the IK's accelerations and the wrenches."""
+        """tau_ff [N m] from the floating base's inverse dynamics: the base accelerates as
+        the planned wrenches and the IK's joint accelerations a_j make it (the base rows
+        of M a + h = S^T tau + J^T f, which no torque enters), and the joints' rows give
+        the torques for that motion."""
         model = self.model
-        acceleration = np.zeros(model.nv)
-        acceleration[6:] = self._acceleration
-        generalized = model.inverse_dynamics(acceleration)
-        self.expected_contact_force = np.zeros(model.nv)
+        contact_force = np.zeros(model.nv)
         for foot, contact, wrench in zip(feet, self._contacts, wrenches, strict=True):
-            self.expected_contact_force += model.wrench_generalized_force(
-                foot, contact.sole_point, wrench
-            )
-        return (generalized - self.expected_contact_force)[6:]
+            contact_force += model.wrench_generalized_force(foot, contact.sole_point, wrench)
+        self.expected_contact_force = contact_force
+        mass_matrix = model.mass_matrix()
+        bias = model.inverse_dynamics(np.zeros(model.nv))
+        joints = self._acceleration
+        base = np.linalg.solve(
+            mass_matrix[:6, :6], contact_force[:6] - bias[:6] - mass_matrix[:6, 6:] @ joints
+        )
+        return (
+            mass_matrix[6:, :6] @ base + mass_matrix[6:, 6:] @ joints + bias[6:] - contact_force[6:]
+        )
+
+    def _friction(self, velocity: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The motors' friction [N m] at the planned joint velocities [rad/s], which the
+        feed-forward adds (friction compensation; the sign smoothed over
+        ``FRICTION_SPEED``): the nominal model's Coulomb and viscous terms."""
+        return (
+            self._static_friction * np.tanh(velocity / FRICTION_SPEED)
+            + self._viscous_friction * velocity
+        )
 
     # ---------------------------------------------------------- observation
+    def load(self, foot: str) -> float:
+        """``foot``'s estimated normal force [N] at the last reading (0: in the air)."""
+        return self.loads.get(foot, 0.0)
+
+    def _update_loads(self, measurement: RobotMeasurement, state: RobotState) -> None:
+        """Each foot's normal force: its force sensor's, else the contact observer's."""
+        if measurement.foot_forces is not None:
+            self.loads = {f: r.normal_force for f, r in measurement.foot_forces.items()}
+            return
+        assert self.observer is not None  # a robot without foot sensors has one
+        if self._start is not None:
+            self.observer.reset(state.q, state.v)
+        previous = self._observed_time
+        dt = self.period if previous is None else measurement.time - previous
+        self._observed_time = measurement.time
+        # The joints feel the motors' torques less their friction (the nominal model's).
+        torques = measurement.joint_torques - self._friction(measurement.joint_velocities)
+        self.loads = dict(self.observer.update(state.q, state.v, torques, max(dt, 1e-9)))
+
     def observe(
         self, measurement: RobotMeasurement, stance: Foot, double_support: bool
     ) -> MeasuredState:
@@ -435,13 +500,20 @@ class WholeBodyController:
         :func:`app.stabilizer.centroidal.momentum_velocity`) and, in single support, the
         stance sole (the planner re-anchors its foothold there) and whether the swing sole
         touches the ground (a step due before the touchdown waits for it)."""
-        self.state = state = self.estimator.update(measurement, stance)
-        sole, swing_contact = None, None
         threshold = CONTACT_LOAD * self.mass * GRAVITY
+        if self._start is not None:  # the first reading after a reset
+            self.estimator.reset(self._start, measurement)
+        planned = ("left", "right") if double_support else (stance,)
+        # The planned supports that carried load at the last reading stand still.
+        contacts = [f for f in planned if self._start is not None or self.load(f) > threshold]
+        self.state = state = self.estimator.update(measurement, contacts)
+        self._update_loads(measurement, state)
+        self._start = None
+        sole, swing_contact = None, None
         if not double_support:
-            if measurement.normal_force(stance) > threshold:
+            if self.load(stance) > threshold:
                 sole = self.model.sole_frame(stance)[0][:2].copy()
-            swing_contact = measurement.normal_force(other_foot(stance)) > threshold
+            swing_contact = self.load(other_foot(stance)) > threshold
         velocity = centroidal.momentum_velocity(
             state.com_velocity[:2],
             self.model.centroidal_angular_momentum()[:2],
@@ -449,7 +521,15 @@ class WholeBodyController:
             self.lipm.com_height,
             self.description.rotational_height,
         )
-        return MeasuredState(state.time, state.com[:2].copy(), velocity, swing_contact, sole)
+        previous = self._filtered_time
+        self._filtered_time = state.time
+        com, velocity = self.com_filter.update(
+            state.com[:2],
+            velocity,
+            self._pivot,
+            0.0 if previous is None else state.time - previous,
+        )
+        return MeasuredState(state.time, com, velocity, swing_contact, sole)
 
 
 def joint_impedance(
