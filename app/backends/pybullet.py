@@ -26,6 +26,7 @@ from scipy.spatial.transform import Rotation
 from app.backends.base import FallStatus, InitialCondition
 from app.backends.physics_log import PhysicsLog
 from app.backends.pybullet_robot import GROUND_HALF_SIZE, SimulatedRobot
+from app.backends.sensors import Sensors
 from app.lowlevel import RobotMeasurement
 from app.reality import DEFAULT_PROFILE, RealityDraw, robot_reality
 from app.stabilizer.config import OPTION_NAMES, StabilizerConfig
@@ -86,11 +87,10 @@ def simulated_robot(description: RobotDescription, reality: RealityDraw) -> Simu
             (reality.torso_link, reality.torso_added_mass),
             (reality.torso_link, reality.com_offset),
         )
+    sensors = Sensors(description, reality.noise, reality.gyro_yaw_bias, reality.sample_rng())
     sim = SimulatedRobot(
         description,
-        noise=reality.noise,
-        yaw_bias=reality.gyro_yaw_bias,
-        rng=reality.sample_rng(),
+        sensors=sensors,
         delay=reality.delay,
         urdf_text=urdf_text,
         ground_friction=reality.ground_friction,

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from app.backends.joint_motors import JointMotors
-from app.backends.sensors import NoiseLevels, Sensors
+from app.backends.sensors import Sensors
 from app.lowlevel import FootForce, JointCommand, RobotMeasurement, SimulatorTruth
 from kinematics.native_output import native_output_silenced
 from kinematics.robot_model import RobotModel, yaw_of
@@ -61,18 +61,14 @@ class SimulatedRobot:
     def __init__(
         self,
         description: RobotDescription,
-        noise: NoiseLevels | None = None,
-        yaw_bias: float = 0.0,
-        rng: np.random.Generator | None = None,
+        sensors: Sensors | None = None,
         delay: float = 0.0,
         urdf_text: str | None = None,
         ground_friction: float | None = None,
     ) -> None:
         """Args:
         description: The robot.
-        noise: The sensors' noise (None: exact readings).
-        yaw_bias: The gyroscope's yaw bias [rad/s].
-        rng: The sensors' noise stream.
+        sensors: The robot's sensors (None: exact readings).
         delay: How late [s] the low-level command reaches the motors (rounded to
             physics steps).
         urdf_text: The physics URDF's text (None: the description's derived URDF).
@@ -163,7 +159,7 @@ class SimulatedRobot:
         self._queue: deque[tuple[NDArray[np.float64], ...]] = deque(maxlen=self._delay_steps + 1)
         self._motor_target = np.zeros(count)
         self.applied_torques = np.zeros(count)
-        self.sensors = Sensors(description, noise, yaw_bias, rng)
+        self.sensors = sensors or Sensors(description)
 
     # ----------------------------------------------------------------- state
     def set_configuration(
