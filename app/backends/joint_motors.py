@@ -65,18 +65,27 @@ class JointMotors:
             limit[fast] *= np.clip((self.no_load[fast] - speed[fast]) / span, 0.0, 1.0)
         return np.clip(torque, -limit, limit)
 
+    def driver(
+        self,
+        command: JointCommand,
+        positions: NDArray[np.float64],
+        velocities: NDArray[np.float64],
+    ) -> NDArray[np.float64]:
+        """The drivers' torques [N m] for ``command`` at the encoder readings: the law
+        within the torque-speed limit (what a motor's current gives, ``tau_est``)."""
+        law = (
+            command.stiffness * (command.position - positions)
+            + command.damping * (command.velocity - velocities)
+            + command.torque
+        )
+        return self.clip(law, velocities)
+
     def torques(
         self,
         command: JointCommand,
         positions: NDArray[np.float64],
         velocities: NDArray[np.float64],
     ) -> NDArray[np.float64]:
-        """The joint torque [N m] for ``command`` at the encoder readings: the driver's law
-        within the torque-speed limit, less the viscous friction (the Coulomb friction is
-        the engine's, module docstring)."""
-        law = (
-            command.stiffness * (command.position - positions)
-            + command.damping * (command.velocity - velocities)
-            + command.torque
-        )
-        return self.clip(law, velocities) - self.viscous_friction * velocities
+        """The joints' torques [N m]: the drivers' less the viscous friction (the Coulomb
+        friction is the engine's, module docstring)."""
+        return self.driver(command, positions, velocities) - self.viscous_friction * velocities

@@ -156,7 +156,7 @@ class SimulatedRobot:
         )
         self._gain_scales = (np.ones(count), np.ones(count))
         self._delay_steps = round(delay / self.time_step)
-        self._queue: deque[tuple[NDArray[np.float64], ...]] = deque(maxlen=self._delay_steps + 1)
+        self._queue: deque[JointCommand] = deque(maxlen=self._delay_steps + 1)
         self._motor_target = np.zeros(count)
         self.applied_torques = np.zeros(count)
         self.sensors = sensors or Sensors(description)
@@ -370,20 +370,17 @@ class SimulatedRobot:
         kd = command.damping * self._gain_scales[1]
         start = self._motor_target
         if not self._queue:  # after a reset: the motors held the first target
-            hold = (start, np.zeros_like(start), kp, kd, np.zeros_like(start))
+            hold = JointCommand(start, np.zeros_like(start), kp, kd, np.zeros_like(start))
             self._queue.extend([hold] * self._queue.maxlen)  # type: ignore[operator]
         queue, motors, client = self._queue, self.motors, self._client_id
         applied = np.zeros(len(start))
         for step in range(1, steps + 1):
             target = start + (step / steps) * (command.position - start)
-            queue.append((target, command.velocity, kp, kd, command.torque))
-            position, velocity, stiffness, damping, torque = queue[0]
+            queue.append(JointCommand(target, command.velocity, kp, kd, command.torque))
             states = pybullet.getJointStates(self.body, self._model_indices, physicsClientId=client)
             q = np.array([s[0] for s in states])
             qd = np.array([s[1] for s in states])
-            driver = motors.clip(
-                stiffness * (position - q) + damping * (velocity - qd) + torque, qd
-            )
+            driver = motors.driver(queue[0], q, qd)
             applied += driver
             self._set_motors(
                 self.body,

@@ -19,38 +19,18 @@ the same noise.
 
 from __future__ import annotations
 
-from typing import Protocol
-
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from app.lowlevel import FootForce, ImuReading, RobotMeasurement, SimulatorTruth
+from app.reality import SensorNoise
 from robots.description import RobotDescription
 
 GRAVITY = 9.81  # [m/s^2]
 # [s] an attitude filter's crossover between gyroscope and gravity (a complementary
 # filter's time constant, e.g. Mahony et al., IEEE TAC 2008, gains of about 1 rad/s)
 ATTITUDE_CORRELATION_TIME = 1.0
-
-
-class NoiseLevels(Protocol):
-    """Standard deviations of the sensors' noise (:class:`app.reality.SensorNoise`)."""
-
-    @property
-    def joint_position(self) -> float: ...  # [rad]
-    @property
-    def joint_velocity(self) -> float: ...  # [rad/s]
-    @property
-    def joint_torque(self) -> float: ...  # [N m]
-    @property
-    def gyroscope(self) -> float: ...  # [rad/s]
-    @property
-    def accelerometer(self) -> float: ...  # [m/s^2]
-    @property
-    def orientation(self) -> float: ...  # [rad]
-    @property
-    def foot_force(self) -> float: ...  # [N]
 
 
 class Sensors:
@@ -66,7 +46,7 @@ class Sensors:
     def __init__(
         self,
         description: RobotDescription,
-        noise: NoiseLevels | None = None,
+        noise: SensorNoise | None = None,
         yaw_bias: float = 0.0,
         rng: np.random.Generator | None = None,
     ) -> None:

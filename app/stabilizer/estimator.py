@@ -101,15 +101,6 @@ class StateEstimator:
         self._anchors = {}
         self._tilt = np.zeros(2)
 
-    @property
-    def base_position(self) -> NDArray[np.float64]:
-        return self._x[:3].copy()
-
-    @property
-    def base_velocity(self) -> NDArray[np.float64]:
-        """Estimated base velocity in the world [m/s]."""
-        return self._x[3:].copy()
-
     def _configuration(
         self, measurement: RobotMeasurement, base_position: NDArray[np.float64]
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
