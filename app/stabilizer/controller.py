@@ -184,8 +184,7 @@ class WholeBodyController:
         self._landed: set[Foot] = {"left", "right"}  # supports that touched down since planned
         self.loads: dict[str, float] = {}  # [N] each foot's estimated normal force
         self._start: dict[Foot, NDArray[np.float64]] | None = None  # soles at reset [m]
-        self._observed_time: float | None = None
-        self._filtered_time: float | None = None
+        self._last_reading: float | None = None  # [s] the time of the last measurement
         self._pivot = np.array(com_xy, dtype=float)  # [m] the pivot of the last tick
 
     def reset(
@@ -477,17 +476,18 @@ class WholeBodyController:
         """``foot``'s estimated normal force [N] at the last reading (0: in the air)."""
         return self.loads.get(foot, 0.0)
 
-    def _update_loads(self, measurement: RobotMeasurement, state: RobotState) -> None:
-        """Each foot's normal force: its force sensor's, else the contact observer's."""
+    def _update_loads(
+        self, measurement: RobotMeasurement, state: RobotState, elapsed: float | None
+    ) -> None:
+        """Each foot's normal force: its force sensor's, else the contact observer's
+        (``elapsed`` [s] since the last reading, None at the first)."""
         if measurement.foot_forces is not None:
             self.loads = {f: r.normal_force for f, r in measurement.foot_forces.items()}
             return
         assert self.observer is not None  # a robot without foot sensors has one
         if self._start is not None:
             self.observer.reset(state.q, state.v)
-        previous = self._observed_time
-        dt = self.period if previous is None else measurement.time - previous
-        self._observed_time = measurement.time
+        dt = self.period if elapsed is None else elapsed
         # The joints feel the motors' torques less their friction (the nominal model's).
         torques = measurement.joint_torques - self._friction(measurement.joint_velocities)
         self.loads = dict(self.observer.update(state.q, state.v, torques, max(dt, 1e-9)))
@@ -507,7 +507,9 @@ class WholeBodyController:
         # The planned supports that carried load at the last reading stand still.
         contacts = [f for f in planned if self._start is not None or self.load(f) > threshold]
         self.state = state = self.estimator.update(measurement, contacts)
-        self._update_loads(measurement, state)
+        elapsed = None if self._last_reading is None else measurement.time - self._last_reading
+        self._last_reading = measurement.time
+        self._update_loads(measurement, state, elapsed)
         self._start = None
         sole, swing_contact = None, None
         if not double_support:
@@ -521,13 +523,8 @@ class WholeBodyController:
             self.lipm.com_height,
             self.description.rotational_height,
         )
-        previous = self._filtered_time
-        self._filtered_time = state.time
         com, velocity = self.com_filter.update(
-            state.com[:2],
-            velocity,
-            self._pivot,
-            0.0 if previous is None else state.time - previous,
+            state.com[:2], velocity, self._pivot, 0.0 if elapsed is None else elapsed
         )
         return MeasuredState(state.time, com, velocity, swing_contact, sole)
 
