@@ -47,6 +47,8 @@ CHROMIUM_FLAGS = [
 ]
 PUSH_LINE = re.compile(r"^push t=(\d+\.\d+) s impulse=\((-?\d+\.\d+), (-?\d+\.\d+)\) N s duration=")
 ADJUSTED_LINE = re.compile(r"^step t=(\d+\.\d+) s foot=(left|right) .* adjusted=yes")
+STEP_LINE = re.compile(r"^step t=")
+PUSH_DELAYS = (0.0, 0.27, 0.54, 0.13)  # [s] after a touchdown, spread over the 0.8 s step
 GROUND_TOLERANCE = 4  # [px] ~1.5 cm at the side view's distance
 PANEL_LEFT = 860  # [px] the GUI panel covers the canvas right of this (1280 px wide)
 # (field, text typed, what the refusal starts with) for the LIPM's 60 kg: each refused.
@@ -269,9 +271,15 @@ MODEL_MASS = {"pybullet": 33.341, "lipm": 60.0}
 
 
 def push_until_adjusted(page, demo: ServerProcess, model: str) -> None:
-    """Press Push (the paper's first push) until a push is followed by an adjusted step:
-    whether a push needs one depends on the gait phase it hits; at most 4 times."""
-    for _attempt in range(4):
+    """Press Push (the paper's first push) until a push is followed by an adjusted step.
+
+    Whether a push needs one depends on the gait phase it hits (on the LIPM a push
+    0.35-0.55 s into a 0.8 s step is absorbed by the ZMP alone), so each attempt waits for
+    a touchdown and presses Push a different delay after it: a 0.25 s window of phases
+    holds at most two of the four delays."""
+    for delay in PUSH_DELAYS:
+        demo.wait_for_line(STEP_LINE, timeout=60, start=len(demo.lines))
+        page.wait_for_timeout(delay * 1000.0)
         before = len(demo.lines)
         click(page, button(page, "Push"))
         index, push = demo.wait_for_line(PUSH_LINE, timeout=60, start=before)
