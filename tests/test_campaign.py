@@ -312,3 +312,40 @@ def test_small_g1_campaign(tmp_path: Path) -> None:
         assert twin["push_time"] == pytest.approx(run["push_time"]), row  # both step at t_4
     summary = summarize(spec, rows)["rsg"]
     assert summary["twin_recovered"] == 2
+
+
+def test_the_push_is_timed_from_the_gait_state_not_from_a_step_count() -> None:
+    """A robot that took an extra, adjusted step as it started walking is pushed from its
+    first touchdown at or after the nominal t_k of step ``cycle`` on the foot that step
+    puts down (as IHMC's tests trigger on the gait state), not from its k-th touchdown,
+    which came during its start."""
+    from types import SimpleNamespace
+
+    from app.experiments.trial import measured_touchdown
+    from app.runner import StepRecord
+    from app.setup.build import build_backend
+    from planner.exceptions import RsgError
+
+    _, config, initial = build_backend("lipm", "g1", "rsg")
+    gait = config.gait
+    nominal = gait.single_support_duration + 3 * gait.step_duration  # step 4: 3.1 s
+    fourth = initial.stance.foot  # steps 1, 3 put down the first swing foot, 2, 4 the other
+    other = initial.swing.foot
+    backend = SimpleNamespace(control_period=0.01)
+
+    def walk(*touchdowns: tuple[float, str], fell: bool = False):
+        steps = [StepRecord({"t": t, "foot": foot}, [0.0, 0.0]) for t, foot in touchdowns]
+        return lambda *args, **kwargs: SimpleNamespace(
+            steps=steps, fall=SimpleNamespace(fell=fell, reason="fell" if fell else "")
+        )
+
+    nominal_walk = walk((0.7, other), (1.5, fourth), (2.3, other), (nominal, fourth))
+    assert measured_touchdown(nominal_walk, backend, config, initial, 4) == nominal
+    started_late = walk((0.25, other), (0.6, fourth), (1.4, other), (2.2, fourth),
+                        (nominal - 0.1, other), (nominal + 0.7, fourth))  # fmt: skip
+    assert measured_touchdown(started_late, backend, config, initial, 4) == nominal + 0.7
+    a_tick_early = walk((1.4, other), (2.2, fourth), (nominal - 0.01, fourth))
+    assert measured_touchdown(a_tick_early, backend, config, initial, 4) == nominal - 0.01
+    for never in (walk((0.7, other), (1.5, fourth)), walk((nominal, fourth), fell=True)):
+        with pytest.raises(RsgError, match=f"no touchdown of the {fourth} foot"):
+            measured_touchdown(never, backend, config, initial, 4)

@@ -219,3 +219,37 @@ def test_the_controller_runs_without_pybullet():
     joints, vertical = result.stdout.split()[-2:]
     assert int(joints) == 29 - len(G1.locked_joints)
     assert float(vertical) > 0.0
+
+
+def test_the_legs_are_compliant_around_a_touchdown_and_stiff_between():
+    """After a step onto the right foot, the right leg keeps landing_compliance of its
+    gains for 0.05 s; the swing leg (left) over the last 0.1 s before its planned landing
+    (0.8 s after the step); the other joints, the legs in mid-swing and at the start of
+    the walk (no landing) keep theirs."""
+    controller, measurement = standing()
+    share = controller.config.landing_compliance
+    assert share < 1.0
+    legs = {foot: controller._legs[foot] for foot in ("left", "right")}
+    others = np.ones(len(controller.stiffness), bool)
+    others[np.concatenate(list(legs.values()))] = False
+    cases = [  # (time [s], planner command, legs expected soft)
+        (0.0, command(0.0, np.zeros(2)), ()),  # the walk's start on the left foot
+        (0.01, command(0.01, RIGHT.position, RIGHT, LEFT), ("right",)),  # it stepped
+        (0.04, command(0.04, RIGHT.position, RIGHT, LEFT, since_step=0.03), ("right",)),
+        (0.05, command(0.05, RIGHT.position, RIGHT, LEFT, since_step=0.04), ()),
+        (0.3, command(0.3, RIGHT.position, RIGHT, LEFT, since_step=0.29), ()),
+        (0.76, command(0.76, RIGHT.position, RIGHT, LEFT, since_step=0.75), ("left",)),
+    ]
+    for time, planned, soft in cases:
+        order = controller.tick(dataclasses.replace(measurement, time=time), planned)
+        for foot, joints in legs.items():
+            scale = share if foot in soft else 1.0
+            np.testing.assert_allclose(
+                order.stiffness[joints], scale * controller.stiffness[joints], err_msg=str(time)
+            )
+            np.testing.assert_allclose(order.damping[joints], scale * controller.damping[joints])
+        np.testing.assert_array_equal(order.stiffness[others], controller.stiffness[others])
+    stiff = WholeBodyController(
+        G1_SENSED, SwingTiming(), 0.01, StabilizerConfig(landing_compliance=1.0)
+    )
+    assert stiff._impedance(command(0.0, np.zeros(2)), "left", "right")[0] is stiff.stiffness

@@ -150,7 +150,8 @@ def test_the_estimate_stays_near_the_truth_on_a_pushed_walk():
     (measured 2.0 and 3.8 cm/s; the base position drifts with the legs' odometry, 1 cm),
     the yaw drifting with the gyroscope's bias (0.17 deg in 6 s, its 0.03 deg/s), and
     every touchdown of a swing sole seen from the joint torques within 40 ms (measured:
-    in the same 10 ms tick as the ground's)."""
+    9 of 11 in the same 10 ms tick as the ground's, one a tick and one four ticks later,
+    the leg landing compliant)."""
     rows, contact = pushed_walk("nominal")
     rms = np.sqrt(np.mean(rows**2, axis=0))
     assert np.all(rms[3:5] < 0.06), rms[3:6]
@@ -158,4 +159,4 @@ def test_the_estimate_stays_near_the_truth_on_a_pushed_walk():
     yaw = rows[:, 12]
     assert abs(yaw[-1]) < 0.002 * 6.0, yaw[-1]  # within 4x the bias over 6 s
     delays = touchdown_delays(contact)
-    assert len(delays) >= 5 and delays.max() <= 0.04, delays
+    assert len(delays) >= 5 and delays.max() <= 0.04 + 1e-9, delays

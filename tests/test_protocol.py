@@ -69,10 +69,6 @@ def test_pushes_start_at_mid_swing_and_mid_double_support(robot: str | None) -> 
     check_timing(ProtocolSpec(model="lipm", robot=robot), tolerance=0.5)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="honest plant: the inward push lands at s~ = 0.10 s, not 0.45 s",
-)
 @pytest.mark.slow
 def test_pushes_start_at_mid_swing_and_mid_double_support_on_g1() -> None:
     """On G1 in PyBullet (exact sensors: the bisection's runs and the check's walk the same)."""

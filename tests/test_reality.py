@@ -335,8 +335,12 @@ def test_the_simulated_robot_is_the_drawn_one(tmp_path: Path, monkeypatch) -> No
         expected[names.index(draw.torso_link)] += draw.torso_added_mass
         assert sim.link_masses == pytest.approx(expected, rel=1e-6)
         assert sim.mass != pytest.approx(plain.mass, abs=0.1)
-        friction = sim.client.getDynamicsInfo(sim.ground, -1)[1]
-        assert friction == pytest.approx(draw.ground_friction)
+        # PyBullet's contact friction is the product of the two bodies': each sole's pair
+        # with the ground has the drawn coefficient (not its square)
+        ground = sim.client.getDynamicsInfo(sim.ground, -1)[1]
+        for link in sim.foot_links.values():
+            sole = sim.client.getDynamicsInfo(sim.body, link)[1]
+            assert ground * sole == pytest.approx(draw.ground_friction)
         assert backend.controller.mass == pytest.approx(nominal.controller.mass)
         assert pybullet.isConnected(sim.client._client)
     finally:

@@ -72,7 +72,8 @@ class SimulatedRobot:
         delay: How late [s] the low-level command reaches the motors (rounded to
             physics steps).
         urdf_text: The physics URDF's text (None: the description's derived URDF).
-        ground_friction: Friction of the ground and soles [-] (None: the description's).
+        ground_friction: Friction coefficient of the soles on the ground [-] (None: the
+            description's).
         """
         self.description = description
         self.time_step = description.physics_time_step
@@ -117,7 +118,7 @@ class SimulatedRobot:
             client.changeDynamics(
                 self.body,
                 link,
-                lateralFriction=friction,
+                lateralFriction=1.0,  # PyBullet multiplies the two: the pair's is the ground's
                 spinningFriction=description.sole_spinning_friction,
                 frictionAnchor=1,
             )

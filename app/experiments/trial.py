@@ -21,28 +21,37 @@ def push_timing(config: PlannerConfig, cycle: int, phase: float) -> tuple[float,
 
 
 def measured_touchdown(runner, backend, config, initial, cycle: int, **options) -> float:  # noqa: ANN001
-    """Time [s] at which nominal step ``cycle`` lands in the unpushed walk of ``runner``
-    (:func:`app.runner.run_closed_loop` or a backend's own) on ``backend``.
+    """Time [s] at which the walk of ``runner`` (:func:`app.runner.run_closed_loop` or a
+    backend's own) on ``backend``, unpushed, is where its nominal step ``cycle`` lands:
+    the first touchdown at or after the nominal t_k, on the foot nominal step ``cycle``
+    puts down.
 
     The nominal t_k of :func:`push_timing` is where the reference enters D_S; the loop
     steps at the first tick inside it: at t_k when the ticks fall on it (G1's 10 ms
-    ticks: step 4 at 3.1 s), up to a tick later otherwise, and the delays add up. A
-    push timed from this touchdown hits the same point of the gait on every model, as
-    IHMC's tests trigger on the gait state.
+    ticks: step 4 at 3.1 s), up to a tick later otherwise, and the delays add up. A robot
+    that adjusted steps as it started walking (the honest plant's first steps) may have
+    taken more steps by then: counting steps would push it during that start, at another
+    point of its gait than its twin. A push timed from this touchdown hits the same point
+    of the gait on every model, as IHMC's tests trigger on the gait state.
 
     Raises:
-        RsgError: The walk fell or did not take ``cycle`` steps.
+        RsgError: The walk fell or did not land that foot at or after t_k.
     """
     gait = config.gait
     nominal = gait.single_support_duration + (cycle - 1) * gait.step_duration
-    scenario = Scenario("walk", nominal + gait.step_duration / 2)
+    foot = initial.swing.foot if cycle % 2 == 1 else initial.stance.foot
+    scenario = Scenario("walk", nominal + 2.5 * gait.step_duration)
     result = runner(backend, config, scenario, initial, qp_solver="exact", **options)
-    if result.fall.fell or len(result.steps) < cycle:
-        raise RsgError(
-            f"the unpushed walk took {len(result.steps)} steps by {scenario.duration:g} s "
-            f"(fell: {result.fall.reason or 'no'}): no touchdown of step {cycle} to time the push"
-        )
-    return float(result.steps[cycle - 1].event["t"])
+    tick = getattr(backend, "control_period", 0.0)
+    for record in result.steps if not result.fall.fell else ():
+        event = record.event
+        if event["t"] >= nominal - tick - 1e-9 and event["foot"] == foot:
+            return float(event["t"])
+    raise RsgError(
+        f"the unpushed walk took {len(result.steps)} steps by {scenario.duration:g} s "
+        f"(fell: {result.fall.reason or 'no'}): no touchdown of the {foot} foot at or after "
+        f"{nominal:g} s (step {cycle}) to time the push"
+    )
 
 
 class SettledTrial:

@@ -27,6 +27,11 @@ class StabilizerConfig:
             force, critically damped [rad/s] (0: the LIPM's m g): the feet's moments are
             planned for the force the legs will push with after a touchdown's bounce
             (docs/notes/2026-12-06-height-loop.md).
+        landing_compliance: Share of the legs' joint stiffness and damping kept by the
+            swing leg over the last 0.1 s before its planned landing and by the new stance
+            leg over the first 0.05 s after the step [-] (1: always stiff): a compliant leg
+            takes the impact rather than passing it to the body (impedance modulation,
+            N. Hogan, "Impedance control", J. Dyn. Syst. Meas. Control 107, 1985).
     """
 
     landing_depth: float = 0.005
@@ -35,6 +40,7 @@ class StabilizerConfig:
     flywheel_return_time: float = 0.5
     flywheel_cancel: float = 0.75
     height_frequency: float = 10.0
+    landing_compliance: float = 0.3
 
     def __post_init__(self) -> None:
         for name, (low, high) in RANGES.items():
@@ -53,6 +59,7 @@ RANGES: dict[str, tuple[float, float]] = {
     "flywheel_return_time": (0.05, 10.0),
     "flywheel_cancel": (0.0, 1.0),
     "height_frequency": (0.0, 50.0),
+    "landing_compliance": (0.05, 1.0),
 }
 
 OPTION_NAMES = tuple(field.name for field in fields(StabilizerConfig))

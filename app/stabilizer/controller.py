@@ -23,6 +23,8 @@ The design, loop by loop, with its references and measurements: docs/full-robot.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import NDArray
 
@@ -70,6 +72,9 @@ FRICTION_SPEED = 0.05
 LIPM_PROCESS_NOISE = 1.0
 COM_POSITION_NOISE = 0.003
 COM_VELOCITY_NOISE = 0.05
+# [m/sqrt(s)] the CoM offset's random walk: a torso's CoM or mass off the model is learnt
+# in seconds, while a push's 0.1 s moves it about 1 cm (tests/test_lipm_filter.py)
+COM_OFFSET_DRIFT = 0.005
 # [1/s] the contact observer's low-pass: a touchdown seen within about 1/K = 20 ms
 OBSERVER_BANDWIDTH = 50.0
 
@@ -116,7 +121,11 @@ class WholeBodyController:
         legs = leg_joints(self.ik.robot.model)
         self._legs = {foot: self.model.index_of(legs[foot]) for foot in ("left", "right")}
         self.com_filter = LipmFilter(
-            self.lipm.omega, LIPM_PROCESS_NOISE, COM_POSITION_NOISE, COM_VELOCITY_NOISE
+            self.lipm.omega,
+            LIPM_PROCESS_NOISE,
+            COM_POSITION_NOISE,
+            COM_VELOCITY_NOISE,
+            COM_OFFSET_DRIFT,
         )
         self.observer = None
         if not description.foot_force_sensors:
@@ -170,6 +179,7 @@ class WholeBodyController:
         self._ik_momentum: NDArray[np.float64] | None = None
         self._motion_momentum_rate = np.zeros(2)
         self._stance_yaw = 0.0  # [rad] the stance sole's yaw when it landed
+        self._step_time: float | None = None  # [s] the planner's last step (None: none yet)
         self._swing_error = np.zeros(2)  # [m] see _swing_correction
         self._landing_offset = np.zeros(2)  # [m] see _ik_sole_offsets
         self._ik_soles: dict[Foot, NDArray[np.float64]] = {}  # [m] x, y the IK was given
@@ -219,6 +229,7 @@ class WholeBodyController:
         state = self._estimate(measurement, command)  # measure
         if stance != self._stance:  # the planner stepped: the old stance foot lifts off
             self._start_swing(command, stance, swing)
+            self._step_time = command.time
         # swing foot
         soles = self._sole_targets(command, stance, swing)
         self.sole_targets = {foot: pose[:3, 3].copy() for foot, pose in soles.items()}
@@ -230,7 +241,9 @@ class WholeBodyController:
             self.ik.com_z_target(soles["left"], soles["right"]) - state.com[2],
             state.com_velocity[2],
         )
-        force = centroidal.contact_force(self.lipm, state.com[:2], pivot, lift)
+        # the pendulum's CoM is the kinematic one plus the filter's offset
+        com_offset = self.com_filter.offset
+        force = centroidal.contact_force(self.lipm, state.com[:2] + com_offset, pivot, lift)
         sway = centroidal.sway_rate(force, self.description.rotational_height)
         self.planned_cop = centroidal.centre_of_pressure(
             pivot,
@@ -241,8 +254,15 @@ class WholeBodyController:
             command.double_support,
         )
         com_target, _ = integrate_lipm(
-            self.lipm, state.com[:2], state.com_velocity[:2], pivot, np.zeros(2), np.zeros(2), dt
+            self.lipm,
+            state.com[:2] + com_offset,
+            state.com_velocity[:2],
+            pivot,
+            np.zeros(2),
+            np.zeros(2),
+            dt,
         )
+        com_target = com_target - com_offset
         # IK: the soles' targets as the IK is to reach them (the real body's tilt, a step)
         for foot, offset in self._ik_sole_offsets(command, stance, swing).items():
             soles[foot] = soles[foot].copy()
@@ -254,9 +274,33 @@ class WholeBodyController:
         velocity = (q - self._targets[0]) / dt
         torque = self._feedforward(feet, wrenches) + self._friction(velocity)
         self._targets = (q, self._targets[0])
-        return JointCommand(q, velocity, self.stiffness, self.damping, torque)
+        stiffness, damping = self._impedance(command, stance, swing)
+        return JointCommand(q, velocity, stiffness, damping, torque)
 
     # ----------------------------------------------------------- the stages
+    def _impedance(
+        self, command: PlannerOutput, stance: Foot, swing: Foot
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The joints' stiffness and damping, the legs' lowered around a touchdown
+        (``StabilizerConfig.landing_compliance``): the swing leg's before its planned
+        landing, the new stance leg's after a step this controller saw."""
+        share = self.config.landing_compliance
+        if share >= 1.0:
+            return self.stiffness, self.damping
+        ahead = self.period  # the command holds over the next tick
+        time_since_step = command.time_since_step + ahead
+        landing_time = command.next_step_time - (command.time - command.time_since_step)
+        since_landing = math.inf
+        if self._step_time is not None:
+            since_landing = command.time - self._step_time + ahead
+        landing, landed = self.landing.compliant(landing_time - time_since_step, since_landing)
+        scale = np.ones_like(self.stiffness)
+        if landing and not command.double_support:
+            scale[self._legs[swing]] = share
+        if landed:
+            scale[self._legs[stance]] = share
+        return self.stiffness * scale, self.damping * scale
+
     def _estimate(self, measurement: RobotMeasurement, command: PlannerOutput) -> RobotState:
         """The estimate of ``measurement`` (made by :meth:`observe` unless it is new)."""
         if self.state is None or self.state.time != measurement.time:

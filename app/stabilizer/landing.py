@@ -22,6 +22,7 @@ WINDOW = 0.1  # [s] before the planned landing over which the target sinks
 # [m/s] downwards past the planned landing until the sole touches (IHMC's swing
 # parameters use 0.1-0.3; 0.3 against 0.1 on G1's development pushes: 98 and 95 recovered)
 TOUCHDOWN_SPEED = 0.3
+COMPLIANT_AFTER = 0.05  # [s] after a step over which the new stance leg stays compliant
 
 
 class Landing:
@@ -57,6 +58,13 @@ class Landing:
             sink += TOUCHDOWN_SPEED * max(time_since_step - self._due, 0.0)
         self._last_height = profile - sink
         return self._last_height
+
+    @staticmethod
+    def compliant(time_to_landing: float, time_since_landing: float) -> tuple[bool, bool]:
+        """Whether the swing leg (about to land: within ``WINDOW`` of its planned landing
+        or late) and the new stance leg (within ``COMPLIANT_AFTER`` of its landing) are to
+        be compliant [s, s]."""
+        return time_to_landing < WINDOW, time_since_landing < COMPLIANT_AFTER
 
     def stance_height(self, time_since_step: float) -> float:
         """Target height [m] of the new stance sole in the double support after a step."""
