@@ -58,6 +58,19 @@ class Plant(ABC):
     applied_torques: NDArray[np.float64]
     sensors: Sensors
 
+    @abstractmethod
+    def __init__(
+        self,
+        description: RobotDescription,
+        sensors: Sensors | None = None,
+        delay: float = 0.0,
+        urdf_text: str | None = None,
+        ground_friction: float | None = None,
+    ) -> None:
+        """Load ``description`` from its physics URDF (``urdf_text``: that text with a
+        model error), with its ``sensors``, the command ``delay`` [s] late and the ground's
+        friction [-] (None: the description's)."""
+
     def _init_command_stream(self, delay: float) -> None:
         """The motors' command stream, ``delay`` [s] late (rounded to physics steps);
         ``motors`` and ``time_step`` must be set."""
