@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from app.backends.pybullet_robot import SimulatedRobot
+from app.backends.plant import Plant
 from kinematics.robot_model import yaw_of
 from planner.exceptions import RsgError
 from planner.types import Foot
@@ -76,7 +76,7 @@ class PhysicsLog:
         for foot in ("left", "right"):
             self._plan += [float(v) for v in sole_targets[foot][:3]]
 
-    def record(self, sim: SimulatedRobot, push_force: NDArray[np.float64] | None) -> None:
+    def record(self, sim: Plant, push_force: NDArray[np.float64] | None) -> None:
         """Append the state after the physics step that ``sim`` has just taken."""
         com, velocity = sim.com_state()
         pressure = sim.foot_pressure()

@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation
 
 from app.backends.base import FallStatus, InitialCondition
 from app.backends.physics_log import PhysicsLog
+from app.backends.plant import Plant
 from app.backends.pybullet_robot import GROUND_HALF_SIZE, SimulatedRobot
 from app.backends.sensors import Sensors
 from app.lowlevel import RobotMeasurement
@@ -77,8 +78,11 @@ def check_backend_options(description: RobotDescription, options: Mapping[str, o
         )
 
 
-def simulated_robot(description: RobotDescription, reality: RealityDraw) -> SimulatedRobot:
-    """The simulated robot with ``reality``'s sensors, delay, gains and model errors."""
+def simulated_robot(
+    description: RobotDescription, reality: RealityDraw, plant: type[Plant] = SimulatedRobot
+) -> Plant:
+    """The simulated robot with ``reality``'s sensors, delay, gains and model errors, on
+    the engine of ``plant``."""
     urdf_text = None
     if reality.model_error:
         urdf_text = perturbed_text(
@@ -88,7 +92,7 @@ def simulated_robot(description: RobotDescription, reality: RealityDraw) -> Simu
             (reality.torso_link, reality.com_offset),
         )
     sensors = Sensors(description, reality.noise, reality.gyro_yaw_bias, reality.sample_rng())
-    sim = SimulatedRobot(
+    sim = plant(
         description,
         sensors=sensors,
         delay=reality.delay,
@@ -105,7 +109,8 @@ def simulated_robot(description: RobotDescription, reality: RealityDraw) -> Simu
 
 
 class PyBulletBackend:
-    """A full humanoid in PyBullet implementing :class:`app.backends.base.Backend`.
+    """A full humanoid in PyBullet implementing :class:`app.backends.base.Backend`
+    (another engine: a subclass with another ``plant``, :mod:`app.backends.mujoco`).
 
     Args:
         robot: Registry name or description of the robot; its ``backend_options``
@@ -117,6 +122,7 @@ class PyBulletBackend:
 
     Attributes:
         name: ``"pybullet"``.
+        plant: The simulated robot's class (its engine).
         mass: Total mass measured in PyBullet [kg].
         com_height: Nominal CoM height [m] (the planner's pendulum is
             ``description.pendulum_height``, taller).
@@ -127,6 +133,7 @@ class PyBulletBackend:
     """
 
     name = "pybullet"
+    plant: type[Plant] = SimulatedRobot
 
     def __init__(
         self,
@@ -142,7 +149,7 @@ class PyBulletBackend:
         self._substeps = round(self.control_period / self.description.physics_time_step)
         self._locked_angles = locked_angles(self.description)
         self.reality = reality or robot_reality(self.description, DEFAULT_PROFILE, 0)
-        self.sim = simulated_robot(self.description, self.reality)
+        self.sim = simulated_robot(self.description, self.reality, self.plant)
         self.mass = self.sim.mass
         self.com_height = self.description.com_height
         self.controller = WholeBodyController(
@@ -295,7 +302,7 @@ class PyBulletBackend:
         return report
 
     def close(self) -> None:
-        """Release the PyBullet client."""
+        """Release the simulated robot's engine."""
         self.sim.close()
 
 

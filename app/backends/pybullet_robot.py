@@ -7,9 +7,10 @@ the URDF's inertias, its fixed-joint links merged into their parents
 (:mod:`robots.urdf_merge`: 29 bodies instead of 41, 8 % less CPU time per physics
 step; a ground contact of the head is reported as one of ``torso_link``).
 The joints are torque-driven by :class:`app.backends.joint_motors.JointMotors`, the G1
-driver's law on the low-level command alone, at every physics step (:meth:`actuate`);
-PyBullet's own joint motors hold only the motors' Coulomb friction (``VELOCITY_CONTROL``
-to zero velocity with that force). :meth:`measure` gives what the robot senses
+driver's law on the low-level command alone, at every physics step
+(:meth:`app.backends.plant.Plant.actuate`, shared with the MuJoCo plant); PyBullet's own
+joint motors hold only the motors' Coulomb friction (``VELOCITY_CONTROL`` to zero
+velocity with that force). :meth:`measure` gives what the robot senses
 (:mod:`app.backends.sensors`), :meth:`truth` the simulator's state (:mod:`app.lowlevel`).
 Frames: PyBullet's base pose is the base link's *inertial* frame;
 :meth:`base_pose` converts it to the URDF base frame.
@@ -18,16 +19,16 @@ Frames: PyBullet's base pose is the base link's *inertial* frame;
 from __future__ import annotations
 
 import tempfile
-from collections import deque
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
 from app.backends.joint_motors import JointMotors
+from app.backends.plant import Plant
 from app.backends.sensors import Sensors
-from app.lowlevel import FootForce, JointCommand, RobotMeasurement, SimulatorTruth
+from app.lowlevel import FootForce, SimulatorTruth
 from kinematics.native_output import native_output_silenced
 from kinematics.robot_model import RobotModel, yaw_of
 from robots.description import RobotDescription
@@ -46,7 +47,7 @@ GROUND_SCALE = 1000.0  # [-]
 GROUND_HALF_SIZE = 100.0 * GROUND_SCALE  # [m] the ground spans |x|, |y| <= this
 
 
-class SimulatedRobot:
+class SimulatedRobot(Plant):
     """The robot and the ground in one PyBullet client.
 
     Attributes:
@@ -155,11 +156,7 @@ class SimulatedRobot:
             targetVelocities=[0.0] * count,
             forces=self.motors.static_friction.tolist(),
         )
-        self._gain_scales = (np.ones(count), np.ones(count))
-        self._delay_steps = round(delay / self.time_step)
-        self._queue: deque[JointCommand] = deque(maxlen=self._delay_steps + 1)
-        self._motor_target = np.zeros(count)
-        self.applied_torques = np.zeros(count)
+        self._init_command_stream(delay)
         self.sensors = sensors or Sensors(description)
 
     # ----------------------------------------------------------------- state
@@ -245,11 +242,6 @@ class SimulatedRobot:
             self._contacts = self.client.getContactPoints(bodyA=self.body, bodyB=self.ground)
         return self._contacts
 
-    def feet_in_contact(self) -> set[str]:
-        """Feet whose ankle link touches the ground."""
-        contacts = self.ground_contacts()
-        return {foot for foot, link in self.foot_links.items() if link in contacts}
-
     def foot_pressure(self) -> dict[str, tuple[NDArray[np.float64], float]]:
         """Foot -> (CoP on the ground [m], shape (2,), normal force [N]) of its contacts.
 
@@ -298,10 +290,6 @@ class SimulatedRobot:
         origin, rotation = self._foot_frame(foot, forward_kinematics)
         return origin + rotation @ np.array(self.description.sole_offset), rotation
 
-    def sole_position(self, foot: str, forward_kinematics: bool = True) -> NDArray[np.float64]:
-        """World position [m] of the sole frame origin of ``foot``, shape (3,)."""
-        return self.sole_frame(foot, forward_kinematics)[0]
-
     def sole_yaw(self, foot: str) -> float:
         """Yaw [rad] of ``foot``'s sole about the world z axis (forward kinematics first)."""
         _, rotation = self._foot_frame(foot, True)
@@ -334,67 +322,22 @@ class SimulatedRobot:
             foot_forces=forces,
         )
 
-    def measure(self) -> RobotMeasurement:
-        """What the robot senses now (:mod:`app.backends.sensors`); the motors' torques are
-        the drivers' over the last tick, averaged (the low level reports them at every
-        physics step)."""
-        return self.sensors.read(self.truth(), self.applied_torques)
+    def _joint_state(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Encoder angles [rad] and velocities [rad/s], the model's joint order."""
+        states = pybullet.getJointStates(
+            self.body, self._model_indices, physicsClientId=self._client_id
+        )
+        return np.array([s[0] for s in states]), np.array([s[1] for s in states])
 
-    def set_gain_scales(self, stiffness: NDArray[np.float64], damping: NDArray[np.float64]) -> None:
-        """Factors on each motor's kp and kd [-], the model's joint order: the real gains'
-        error from the commanded ones."""
-        self._gain_scales = (np.asarray(stiffness, float), np.asarray(damping, float))
-
-    def set_motor_target(self, angles: NDArray[np.float64]) -> None:
-        """Hold ``angles`` [rad] (after a reset): the motors' pending commands are this
-        posture with the commanded gains and no feed-forward, and the next tick's target
-        starts from it."""
-        self._motor_target = np.asarray(angles, float).copy()
-        self._queue.clear()
-        self.applied_torques = np.zeros(len(self._motor_target))
-
-    def actuate(
-        self,
-        command: JointCommand,
-        steps: int,
-        base_force_world: NDArray[np.float64] | None = None,
-        observer: Callable[[SimulatedRobot, NDArray[np.float64] | None], None] | None = None,
-    ) -> None:
-        """Run ``steps`` physics steps with the motors on ``command``.
-
-        The command stream the low level receives: at each physics step the target
-        angle moves linearly from the last tick's to ``command.position``; it reaches the
-        motors ``delay`` late. ``base_force_world`` [N] pushes the pelvis; ``observer``
-        is called after each physics step.
-        """
-        kp = command.stiffness * self._gain_scales[0]
-        kd = command.damping * self._gain_scales[1]
-        start = self._motor_target
-        if not self._queue:  # after a reset: the motors held the first target
-            hold = JointCommand(start, np.zeros_like(start), kp, kd, np.zeros_like(start))
-            self._queue.extend([hold] * self._queue.maxlen)  # type: ignore[operator]
-        queue, motors, client = self._queue, self.motors, self._client_id
-        applied = np.zeros(len(start))
-        for step in range(1, steps + 1):
-            target = start + (step / steps) * (command.position - start)
-            queue.append(JointCommand(target, command.velocity, kp, kd, command.torque))
-            states = pybullet.getJointStates(self.body, self._model_indices, physicsClientId=client)
-            q = np.array([s[0] for s in states])
-            qd = np.array([s[1] for s in states])
-            driver = motors.driver(queue[0], q, qd)
-            applied += driver
-            self._set_motors(
-                self.body,
-                self._model_indices,
-                pybullet.TORQUE_CONTROL,
-                forces=(driver - motors.viscous_friction * qd).tolist(),
-                physicsClientId=client,
-            )
-            self.step(base_force_world)
-            if observer is not None:
-                observer(self, base_force_world)
-        self._motor_target = command.position.copy()
-        self.applied_torques = applied / steps
+    def _apply_joint_torques(self, torques: NDArray[np.float64]) -> None:
+        """Hold ``torques`` [N m] (model order) on the joints for the next physics step."""
+        self._set_motors(
+            self.body,
+            self._model_indices,
+            pybullet.TORQUE_CONTROL,
+            forces=torques.tolist(),
+            physicsClientId=self._client_id,
+        )
 
     def step(self, base_force_world: NDArray[np.float64] | None = None) -> None:
         """One physics step (``time_step`` [s]) with a force [N] on the base CoM.

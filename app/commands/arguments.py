@@ -24,6 +24,7 @@ from planner.exceptions import RsgError
 from planner.types import Push
 
 MODELS = ("lipm", "pybullet")
+RUN_MODELS = (*MODELS, "mujoco")  # MuJoCo runs one robot at a time for now (rsg run)
 S = TypeVar("S")
 
 
@@ -132,13 +133,16 @@ def out_argument(text: str) -> Path:
 
 
 def add_model_and_robot(
-    parser: argparse.ArgumentParser, default_model: str, reality_seed: bool = False
+    parser: argparse.ArgumentParser,
+    default_model: str,
+    reality_seed: bool = False,
+    models: tuple[str, ...] = MODELS,
 ) -> None:
-    """``--model``, ``--robot`` and ``--reality`` (with ``--reality-seed`` when
-    ``reality_seed``: a command that runs once)."""
+    """``--model`` (one of ``models``), ``--robot`` and ``--reality`` (with
+    ``--reality-seed`` when ``reality_seed``: a command that runs once)."""
     parser.add_argument(
         "--model",
-        choices=MODELS,
+        choices=models,
         default=default_model,
         help=f"simulation backend (default: {default_model})",
     )

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from app.commands.arguments import (
+    RUN_MODELS,
     add_command,
     add_model_and_robot,
     add_out_arguments,
@@ -24,7 +25,7 @@ from app.results.run_files import write_results
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, describe_push, load_scenario
 from app.setup.build import backend_reality, build_backend, resolve_robot
-from app.setup.overrides import check_overrides
+from app.setup.overrides import ROBOT_MODELS, check_overrides
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 from planner.types import Push
@@ -103,7 +104,7 @@ def verdict(result: RunResult) -> str:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg run`` to the subcommands."""
     p = add_command(sub, "run", HELP, DESCRIPTION, EPILOG)
-    add_model_and_robot(p, "pybullet", reality_seed=True)
+    add_model_and_robot(p, "pybullet", reality_seed=True, models=RUN_MODELS)
     p.add_argument(
         "--controller",
         choices=(*CONTROLLERS, "placo-wpg"),
@@ -176,9 +177,11 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError(
             "--paper-rules", True, "no --paper-rules with placo-wpg (they are rules of the RSG)"
         )
-    if args.physics_log and args.model != "pybullet":
+    if args.physics_log and args.model not in ROBOT_MODELS:
         raise ParameterError(
-            "--model", args.model, "pybullet with --physics-log (the LIPM has no physics steps)"
+            "--model",
+            args.model,
+            f"{' or '.join(ROBOT_MODELS)} with --physics-log (the LIPM has no physics steps)",
         )
     settings = check_overrides(
         overrides, args.model, robot, "rsg" if wpg else args.controller, args.paper_rules
@@ -250,7 +253,7 @@ def run(args: argparse.Namespace) -> int:
         if reality is not None:
             result.extra["reality_draw"] = reality.as_dict()
         description = getattr(backend, "description", None)
-        if args.model == "pybullet" and description is not None:
+        if args.model in ROBOT_MODELS and description is not None:
             # The physics model: these joints are welded at their standing angles.
             result.extra["locked_joints"] = list(description.locked_joints)
         if overrides:

@@ -10,6 +10,7 @@ from app.backends.physics_log import PhysicsLog
 from app.reality import DEFAULT_PROFILE, RealityDraw, check_profile, robot_reality
 from app.runner import walking_start
 from app.setup.overrides import (
+    ROBOT_MODELS,
     Overrides,
     ParsedOverrides,
     apply_to_description,
@@ -26,10 +27,10 @@ from robots.description import RobotDescription
 
 
 def resolve_robot(model: str, robot: str | None) -> str | None:
-    """The robot a run uses: on ``pybullet`` ``robot`` or :data:`DEFAULT_ROBOT`; on
-    ``lipm`` ``robot`` (``None``: the paper's point mass; a name: that robot's
-    planner configuration, mass, sole, gait and timing, on the point mass)."""
-    if model == "pybullet" and robot is None:
+    """The robot a run uses: on ``pybullet`` or ``mujoco`` ``robot`` or
+    :data:`DEFAULT_ROBOT`; on ``lipm`` ``robot`` (``None``: the paper's point mass; a name:
+    that robot's planner configuration, mass, sole, gait and timing, on the point mass)."""
+    if model in ROBOT_MODELS and robot is None:
         return DEFAULT_ROBOT
     return robot
 
@@ -48,13 +49,13 @@ def build_backend(
 
     Args:
         model, robot, controller: Names as on the command line. ``robot`` ``None``
-            is G1 on ``pybullet`` and the paper's point mass on ``lipm``; a robot on
+            is G1 on ``pybullet`` or ``mujoco`` and the paper's point mass on ``lipm``; a robot on
             ``lipm`` is its planner configuration (mass, sole, gait, timing) on the
             point mass, what the RSG could do if the robot realised the LIPM exactly.
         paper: The paper's rules (:data:`PAPER_RULES` off, :func:`paper_rules`).
         overrides: ``--set`` pairs (:mod:`app.setup.overrides`); RSG parameters among
             them are applied after ``paper``.
-        physics_log: Records every physics step of a ``pybullet`` run (None: nothing).
+        physics_log: Records every physics step of a full-robot run (None: nothing).
         reality: Profile of :mod:`app.reality` (``--reality``); on ``lipm`` checked and
             ignored (the LIPM stays ideal).
         seed: Seed of the reality's draw (:func:`robot_reality`).
@@ -62,8 +63,8 @@ def build_backend(
     Raises:
         ParameterError: Unknown model, robot or reality profile, or a bad override.
     """
-    if model not in ("lipm", "pybullet"):
-        raise ParameterError("--model", model, "lipm or pybullet")
+    if model not in ("lipm", *ROBOT_MODELS):
+        raise ParameterError("--model", model, f"one of lipm, {', '.join(ROBOT_MODELS)}")
     check_profile(reality)
     check_overrides(overrides, model, robot, controller, paper)
     if model == "lipm":
@@ -77,11 +78,9 @@ def build_backend(
             config = paper_rules(config)
         config = replace(config, rsg=apply_to_rsg(config.rsg, parsed))
         return LipmBackend(config.model), config, walking_start(config)
-    if model == "pybullet":
-        return build_robot_backend(
-            robot or DEFAULT_ROBOT, controller, overrides, paper, physics_log, reality, seed
-        )
-    raise ParameterError("--model", model, "lipm or pybullet")
+    return build_robot_backend(
+        robot or DEFAULT_ROBOT, controller, overrides, paper, physics_log, reality, seed, model
+    )
 
 
 def robot_with_overrides(
@@ -108,8 +107,10 @@ def build_robot_backend(  # noqa: ANN201
     physics_log: PhysicsLog | None = None,
     reality: str = DEFAULT_PROFILE,
     seed: int = 0,
+    engine: str = "pybullet",
 ):
-    """PyBullet backend, planner configuration and walking start for ``robot``
+    """Full-robot backend on ``engine`` (``pybullet`` or ``mujoco``), planner
+    configuration and walking start for ``robot``
     (a registry name or a description), with ``overrides`` (``--set``; RSG
     parameters are applied to the configuration, after the paper's rules when
     ``paper``, :func:`app.setup.paper_rules.paper_rules`). The backend's ``description``
@@ -119,9 +120,17 @@ def build_robot_backend(  # noqa: ANN201
     Raises:
         ParameterError: Unknown robot or reality profile, or a bad override.
     """
-    # PyBullet and placo load only for full-robot runs.
+    # PyBullet, MuJoCo and placo load only for full-robot runs.
     from app.backends.pybullet import PyBulletBackend
     from kinematics.swing_foot import SwingTiming
+
+    if engine not in ROBOT_MODELS:
+        raise ParameterError("engine", engine, f"one of {', '.join(ROBOT_MODELS)}")
+    backend_type = PyBulletBackend
+    if engine == "mujoco":
+        from app.backends.mujoco import MujocoBackend
+
+        backend_type = MujocoBackend
 
     check_profile(reality)
     check_overrides(overrides, "pybullet", robot, controller, paper)
@@ -136,7 +145,7 @@ def build_robot_backend(  # noqa: ANN201
         config.gait.step_duration,
     )
     draw = robot_reality(description, reality, seed)
-    backend = PyBulletBackend(description, timing, physics_log, reality=draw)
+    backend = backend_type(description, timing, physics_log, reality=draw)
     config = replace(config, model=replace(config.model, mass=backend.mass))
     initial: InitialCondition = walking_start(config)
     return backend, config, initial

@@ -48,6 +48,9 @@ from robots.description import RobotDescription
 #: (name, value text) pairs as given on the command line, in order.
 Overrides = tuple[tuple[str, str], ...]
 
+#: The models that simulate the whole robot (the same settings on each engine).
+ROBOT_MODELS = ("pybullet", "mujoco")
+
 #: Description fields that may be set: the numbers of the gait, the planner's bounds
 #: and timing, the fall thresholds, PyBullet's time step (the position gains follow,
 #: keeping the servos' time constants) and solver iterations, and the locked joints
@@ -132,7 +135,7 @@ def rsg_parameter_types(model: str = "pybullet", robot: str | None = None) -> di
 def description_field_types(model: str = "pybullet") -> dict[str, str]:
     """Description fields ``--set`` may change on ``model`` (with a robot) -> their kind:
     on the LIPM only those its planner reads."""
-    if model == "pybullet":
+    if model in ROBOT_MODELS:
         return dict(DESCRIPTION_FIELDS)
     return {k: v for k, v in DESCRIPTION_FIELDS.items() if k not in PYBULLET_ONLY_FIELDS}
 
@@ -142,7 +145,7 @@ def allowed_names(model: str = "pybullet", robot: str | None = None) -> list[str
     is the paper's point mass)."""
     if _paper_point_mass(model, robot):
         return sorted(rsg_parameter_types("lipm", None))
-    backend = backend_option_types() if model == "pybullet" else {}
+    backend = backend_option_types() if model in ROBOT_MODELS else {}
     fields = description_field_types(model)
     return sorted({**fields, **backend, **rsg_parameter_types(model, robot)})
 
@@ -233,7 +236,7 @@ def parse_overrides(
     rsg: dict[str, Any] = {}
     paper = _paper_point_mass(model, robot)
     fields = {} if paper else description_field_types(model)
-    backend_types = backend_option_types() if model == "pybullet" else {}
+    backend_types = backend_option_types() if model in ROBOT_MODELS else {}
     rsg_types = rsg_parameter_types(model, robot)
     seen: set[str] = set()
     for name, text in overrides:
@@ -256,7 +259,7 @@ def parse_overrides(
         else:
             if paper:
                 where = " (--model lipm: RSG parameters only)"
-            elif model == "pybullet":
+            elif model in ROBOT_MODELS:
                 where = ""
             else:
                 where = " (--model lipm with a robot: the planner's settings only)"
@@ -325,7 +328,7 @@ def check_overrides(
     Raises:
         ParameterError: A bad override, named as the user wrote it; or a bad ``robot``.
     """
-    if model == "pybullet" and robot is None:
+    if model in ROBOT_MODELS and robot is None:
         from robots import DEFAULT_ROBOT
 
         robot = DEFAULT_ROBOT
@@ -366,7 +369,7 @@ def _build_settings(
         description = apply_to_description(robot, parsed)
         config = planner_config_for(description, description.total_mass, controller)
         period = CONTROL_PERIOD
-        if model == "pybullet":
+        if model in ROBOT_MODELS:
             from app.backends.pybullet import DEFAULT_CONTROL_PERIOD, check_backend_options
             from kinematics.swing_foot import SwingTiming
 
@@ -378,7 +381,7 @@ def _build_settings(
         config = paper_rules(config)
     config = dataclasses.replace(config, rsg=apply_to_rsg(config.rsg, parsed))
     design_lyapunov(config.model, config.constraints, config.rsg)
-    if model == "pybullet":
+    if model in ROBOT_MODELS:
         SwingTiming(
             config.gait.double_support_duration,
             config.rsg.swing_preparation_time,
