@@ -707,8 +707,8 @@ OUT_FOLDERS = [
 RUN_MISC = [
     Case(
         "model-unknown",
-        ["run", "--model", "mujoco", "--out", "{out}"],
-        ("--model", "'mujoco'", "lipm"),
+        ["run", "--model", "gazebo", "--out", "{out}"],
+        ("--model", "'gazebo'", "lipm"),
     ),
     Case(
         "controller-unknown",
@@ -803,7 +803,7 @@ SWEEP_AND_GRID = [
     sweep_case("backend-unknown", ["--backend", "dask"], "--backend", "'dask'"),
     sweep_case("criterion-unknown", ["--criterion", "alive"], "--criterion", "'alive'"),
     sweep_case("robot-unknown", ["--robot", "atlas"], "robot='atlas'"),
-    sweep_case("model-unknown", ["--model", "mujoco"], "--model", "'mujoco'"),
+    sweep_case("model-unknown", ["--model", "gazebo"], "--model", "'gazebo'"),
     grid_case("impulses-empty", ["--impulses", ""], "--impulses=''"),
     grid_case("impulses-zero", ["--impulses", "0"], "impulses=(0.0,)", "(0, 1000] N s"),
     grid_case("impulses-negative", ["--impulses", "-5"], "impulses=(-5.0,)"),
@@ -850,6 +850,9 @@ BENCH = [
     bench_case("samples-huge", ["--samples", "10000000"], "--samples=10000000"),
     bench_case("samples-float", ["--samples", "1e3"], "--samples", "'1e3'"),
     bench_case("robot-unknown", ["--robot", "atlas"], "robot='atlas'"),
+    bench_case("model-unknown", ["--model", "pybullet,gazebo"], "--model='pybullet,gazebo'"),
+    bench_case("model-lipm", ["--model", "lipm"], "--model='lipm'", "pybullet, mujoco"),
+    bench_case("model-twice", ["--model", "mujoco,mujoco"], "--model='mujoco,mujoco'"),
     bench_case(
         "set-with-no-robot",
         ["--no-robot", "--set", "landing_depth=0.004"],

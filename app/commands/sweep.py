@@ -25,6 +25,7 @@ from app.results.worst_runs import (
     worst_sweep_runs,
     write_worst_replays,
 )
+from app.setup.overrides import is_robot_model
 from planner.parameters import CONTROLLERS
 
 HELP = "robustness map: largest recovered impulse per controller, direction and phase"
@@ -62,7 +63,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=csv_names,
         default=None,
         help=f"comma-separated, of {', '.join((*CONTROLLERS, PLACO_WPG))} (default: all that "
-        "fit the model; placo-wpg needs --model pybullet)",
+        "fit the model; placo-wpg needs a full-robot model)",
     )
     p.add_argument("--directions", type=int, default=16, help="push directions (default 16)")
     p.add_argument(
@@ -79,7 +80,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--criterion",
         choices=("recovered", "no-fall"),
         default=None,
-        help="recovered (lipm default) or no-fall (pybullet default)",
+        help="recovered (lipm default) or no-fall (pybullet and mujoco default)",
     )
     p.add_argument(
         "--monotonicity",
@@ -95,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``rsg sweep``; returns 0."""
     controllers = args.controllers
     if controllers is None:
-        with_wpg = args.model == "pybullet"
+        with_wpg = is_robot_model(args.model)
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
     criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
     spec = spec_from_args(SweepSpec, args, controllers=tuple(controllers), criterion=criterion)
