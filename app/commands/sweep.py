@@ -39,6 +39,7 @@ examples:
   rsg sweep --model lipm --directions 16 --out results/sweep
   rsg sweep --model lipm --controllers rsg,no-step --phases 0.5 --directions 8 --out /tmp/s
   rsg sweep --model pybullet --controllers rsg,placo-wpg --directions 4 --phases 0.25 --out r
+  rsg sweep --model mujoco --controllers rsg --directions 4 --phases 0.25 --out results/s-mj
   rsg sweep --backend ray --workers 64 --out results/sweep   # on a Ray cluster (RAY_ADDRESS)
   rsg sweep --model lipm --directions 8 --out results/sweep --monotonicity  # then 1/4, 1/2, 3/4
 
