@@ -160,7 +160,7 @@ def measure(model: str, renderer: str, pushes: int, settle: float) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--model", choices=("lipm", "pybullet"), default="pybullet")
+    parser.add_argument("--model", choices=("lipm", "pybullet", "mujoco"), default="pybullet")
     parser.add_argument("--renderer", choices=tuple(VIEWPORTS), default="slow")
     parser.add_argument("--pushes", type=int, default=5)
     parser.add_argument("--settle", type=float, default=40.0, help="wait after load [s]")

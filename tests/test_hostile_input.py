@@ -850,6 +850,9 @@ BENCH = [
     bench_case("samples-huge", ["--samples", "10000000"], "--samples=10000000"),
     bench_case("samples-float", ["--samples", "1e3"], "--samples", "'1e3'"),
     bench_case("robot-unknown", ["--robot", "atlas"], "robot='atlas'"),
+    bench_case("model-unknown", ["--model", "pybullet,gazebo"], "--model='pybullet,gazebo'"),
+    bench_case("model-lipm", ["--model", "lipm"], "--model='lipm'", "pybullet, mujoco"),
+    bench_case("model-twice", ["--model", "mujoco,mujoco"], "--model='mujoco,mujoco'"),
     bench_case(
         "set-with-no-robot",
         ["--no-robot", "--set", "landing_depth=0.004"],

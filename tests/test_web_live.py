@@ -149,17 +149,19 @@ def test_the_live_loop_keeps_bounded_memory_however_long_it_runs():
 
 
 @pytest.mark.usefixtures("cache_in_tmp")
-def test_the_g1_page_draws_the_com_where_the_robot_carries_it():
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_the_g1_page_draws_the_com_where_the_robot_carries_it(engine):
     """The planner's pendulum is taller than G1's CoM (c_z + h_r, robots/g1.py): the
     page still draws the CoM marker at the CoM of the robot it draws, computed from the
-    same snapshot's pose, within 2 cm (10 cm higher if drawn at the pendulum)."""
+    same snapshot's pose, within 2 cm (10 cm higher if drawn at the pendulum), on
+    either engine (the status names it)."""
     import numpy as np
 
     from kinematics.robot_model import RobotModel
     from robots import get_robot
     from web.scene_model import draw_scene
 
-    live = LiveSimulation("pybullet", "g1", "rsg", "walk", log=lambda _: None)
+    live = LiveSimulation(engine, "g1", "rsg", "walk", log=lambda _: None)
     live.start()
     try:
         assert wait_for(lambda: live.snapshot().status.time > 1.0, timeout=120.0)
@@ -167,6 +169,7 @@ def test_the_g1_page_draws_the_com_where_the_robot_carries_it():
     finally:
         live.stop()
     assert snap.state is not None and snap.robot is not None
+    assert snap.status.model == engine and not snap.status.fell
     drawing = draw_scene(snap.state, snap.foot_lower, snap.foot_upper)
     model = RobotModel(get_robot("g1"))
     pose = snap.robot

@@ -47,10 +47,11 @@ def server():
     server.stop()
 
 
-def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
-    """Standing, mid-swing of each foot and after a push: every drawn sole within 5 mm
-    and 0.5 deg of the simulation's sole frame, the pelvis within 5 mm of the
-    simulated base, and the drawn stance foot's lowest vertex on the ground."""
+@pytest.mark.parametrize("engine", ["pybullet", "mujoco"])
+def test_drawn_soles_and_pelvis_are_the_simulated_ones(server, engine):
+    """Standing, mid-swing of each foot and after a push, on either engine: every drawn
+    sole within 5 mm and 0.5 deg of the engine's own sole frame, the pelvis within 5 mm
+    of the simulated base, and the drawn stance foot's lowest vertex on the ground."""
     from app.runner import ClosedLoop
     from app.scenarios import Scenario
     from app.setup.build import build_backend
@@ -58,7 +59,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
     from robots.urdf_cache import derived_urdf
     from web.robot_view import RobotView
 
-    backend, config, initial = build_backend("pybullet", "g1", "rsg", reality="ideal")
+    backend, config, initial = build_backend(engine, "g1", "rsg", reality="ideal")
     push = Push(1.5, np.array([0.0, 4.0]), 0.1)
     loop = ClosedLoop(backend, config, Scenario("walk", 3.0, (push,)), initial)
     world = server.scene.add_frame("/world", show_axes=False, position=WORLD_SHIFT)
@@ -89,7 +90,7 @@ def test_drawn_soles_and_pelvis_are_the_simulated_ones(server):
             x, y, z, w = quaternion_xyzw
             view.update(position, np.array([w, x, y, z]), joints)
             poses = world_poses(nodes)
-            case = f"t={time} s"
+            case = f"{engine} t={time} s"
             pelvis = poses[view.link_nodes["pelvis"]]
             np.testing.assert_allclose(
                 pelvis[:3, 3], position + WORLD_SHIFT, atol=POSITION_TOLERANCE, err_msg=case

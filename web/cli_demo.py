@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 
 from app.commands.arguments import add_reality_argument, add_robot_argument
+from app.setup.overrides import ROBOT_MODELS
 from planner.parameters import CONTROLLERS
 from web.live import SLOW_MOTION_FACTORS
 
@@ -15,6 +16,7 @@ DEMO_EPILOG = """\
 examples:
   rsg demo                                 # G1 in PyBullet, http://127.0.0.1:8080
   rsg demo --model lipm --port 8081        # point-mass LIPM, fast
+  rsg demo --model mujoco                  # G1 in MuJoCo
   rsg demo --scenario paper-fig6           # the paper's two pushes, plus yours
   rsg demo --reality randomized --reality-seed 4   # G1 with drawn model errors and noise
 
@@ -75,9 +77,10 @@ def add_demo_parser(sub: argparse._SubParsersAction) -> argparse.ArgumentParser:
     demo = add_page_parser(sub, "demo", DEMO_HELP, DEMO_DESCRIPTION, DEMO_EPILOG)
     demo.add_argument(
         "--model",
-        choices=("pybullet", "lipm"),
+        choices=(*ROBOT_MODELS, "lipm"),
         default="pybullet",
-        help="pybullet: full robot (URDF meshes); lipm: point mass (default: pybullet)",
+        help="pybullet or mujoco: the full robot on that engine (URDF meshes); lipm: point "
+        "mass (default: pybullet)",
     )
     add_robot_argument(demo)
     add_reality_argument(demo, reality_seed=True)

@@ -13,13 +13,14 @@ from pathlib import Path
 import viser
 
 from app.reality import DEFAULT_PROFILE
+from app.setup.overrides import is_robot_model
 
 from .live import LiveSimulation
 from .serve import check_address, serve
 
 
 def _robot_urdf(model: str, robot: str | None) -> Path | None:
-    if model != "pybullet":
+    if not is_robot_model(model):
         return None
     from robots import DEFAULT_ROBOT, get_robot
     from robots.urdf_cache import derived_urdf

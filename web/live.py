@@ -79,8 +79,8 @@ class LiveSimulation:
     """The closed loop running in a background thread, driven by requests.
 
     Args:
-        model: ``lipm`` or ``pybullet``.
-        robot: Robot name (``None``: G1 on ``pybullet``, the paper's point mass on
+        model: ``lipm``, ``pybullet`` or ``mujoco``.
+        robot: Robot name (``None``: G1 on a full-robot model, the paper's point mass on
             ``lipm``; a robot on ``lipm`` is its planner on the point mass).
         controller: One of :data:`planner.parameters.CONTROLLERS`.
         scenario: Built-in scenario name or TOML path; its pushes are applied too.

@@ -31,7 +31,7 @@ def sole_corners(window_min: ArrayLike, window_max: ArrayLike) -> tuple[Array, A
 
 @dataclass(frozen=True)
 class RobotPose:
-    """Configuration of the full robot (PyBullet backend).
+    """Configuration of the full robot (PyBullet or MuJoCo backend).
 
     Attributes:
         base_position: URDF base (pelvis) position [m], shape (3,).
@@ -50,7 +50,7 @@ class PageStatus:
 
     Attributes:
         time: Simulated time [s].
-        model: Backend (``lipm`` or ``pybullet``); robot: robot name.
+        model: Backend (``lipm``, ``pybullet`` or ``mujoco``); robot: robot name.
         controller: Step controller in the loop.
         paused: Paused by the user.
         slow_motion: Requested simulated seconds per wall second [-].

@@ -375,16 +375,19 @@ def build_placo_wpg_backend(  # noqa: ANN201
     physics_log: PhysicsLog | None = None,
     reality: str = DEFAULT_PROFILE,
     seed: int = 0,
+    engine: str = "pybullet",
 ):
-    """PyBullet backend, configuration, initial condition and planner factory of placo-wpg.
+    """Full-robot backend on ``engine``, configuration, initial condition and planner
+    factory of placo-wpg.
 
     The backend, IK and configuration are the RSG's (:func:`app.setup.build.
     build_robot_backend`, with ``overrides``, ``physics_log`` and the reality profile
     ``reality`` drawn from ``seed``); the initial state is placo's plan at t = 0.
     """
     backend, config, _ = build_robot_backend(
-        robot, "rsg", overrides, physics_log=physics_log, reality=reality, seed=seed
-    )
+        robot, "rsg", overrides, physics_log=physics_log, reality=reality, seed=seed,
+        engine=engine,
+    )  # fmt: skip
     factory = planner_factory(backend.description)
     initial = factory(config).initial_condition()
     return backend, config, initial, factory

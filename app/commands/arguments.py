@@ -18,13 +18,17 @@ from app.reality import DEFAULT_PROFILE, PROFILES, PROFILES_HELP
 from app.results.folder import MAX_PATH_LENGTH
 from app.scenarios import MAX_DURATION, parse_push
 from app.setup.build import check_robot_overrides
-from app.setup.overrides import MAX_VALUE_LENGTH, parse_decimal
+from app.setup.overrides import (
+    MAX_VALUE_LENGTH,
+    MODELS,
+    ROBOT_MODELS,
+    is_robot_model,
+    parse_decimal,
+)
 from app.setup.paper_rules import PAPER_RULES_HELP
 from planner.exceptions import RsgError
 from planner.types import Push
 
-MODELS = ("lipm", "pybullet")
-RUN_MODELS = (*MODELS, "mujoco")  # MuJoCo runs one robot at a time for now (rsg run)
 S = TypeVar("S")
 
 
@@ -144,7 +148,8 @@ def add_model_and_robot(
         "--model",
         choices=models,
         default=default_model,
-        help=f"simulation backend (default: {default_model})",
+        help=f"simulation backend: lipm (the point mass) or a full robot on "
+        f"{' or '.join(ROBOT_MODELS)} (default: {default_model})",
     )
     add_robot_argument(parser)
     add_reality_argument(parser, reality_seed)
@@ -186,12 +191,13 @@ def seed_argument(name: str) -> Callable[[str], int]:
 
 
 def add_robot_argument(parser: argparse.ArgumentParser) -> None:
-    """``--robot`` (default ``None``: G1 on ``pybullet``, the paper's point mass on
+    """``--robot`` (default ``None``: G1 on a full-robot model, the paper's point mass on
     ``lipm``)."""
     parser.add_argument(
         "--robot",
         default=None,
-        help="robot (default: g1 on --model pybullet; on --model lipm the paper's point "
+        help=f"robot (default: g1 on --model {' or '.join(ROBOT_MODELS)}; on --model lipm "
+        "the paper's point "
         "mass, or with --robot that robot's planner: its mass, sole, gait and timing on "
         "the point mass)",
     )
@@ -218,7 +224,7 @@ def add_set_argument(parser: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME=VALUE",
-        help="change one parameter: a robot description field, a PyBullet backend option "
+        help="change one parameter: a robot description field, a full-robot backend option "
         "or an RSG parameter, e.g. --set swing_preparation_time=0.3 --set landing_depth=0.003 "
         "(repeatable; a wrong name lists the allowed ones, a value out of range gives the "
         "range)",
@@ -290,8 +296,8 @@ def job_workers(args: argparse.Namespace, spec: Any) -> int:
     starts)."""
     workers = workers_of(args)
     check_workers(workers, getattr(args, "backend", "process"))
-    if spec.model == "pybullet":
-        check_robot_overrides(spec.robot, spec.overrides)
+    if is_robot_model(spec.model):
+        check_robot_overrides(spec.robot, spec.overrides, spec.model)
     return workers
 
 

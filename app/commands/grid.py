@@ -41,6 +41,7 @@ examples:
   rsg grid --phases 0.25 --controllers rsg --out results/grid-g1-early
   rsg grid --controllers rsg --set swing_preparation_time=0.3 --out results/grid-g1-tsp03
   rsg grid --model lipm --impulses 20,40,60 --directions 16 --out results/grid-lipm
+  rsg grid --model mujoco --controllers rsg --out results/grid-g1-mujoco   # G1 on MuJoCo
 
 outputs in --out:
   grid.json   the specification, counts per controller, phase and impulse, every run

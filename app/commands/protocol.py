@@ -32,6 +32,7 @@ examples:
   rsg protocol --model lipm --robot g1 --out results/protocol-g1-lipm    # G1's planner alone
   rsg protocol --model pybullet --controllers rsg,no-step --out results/protocol-g1
   rsg protocol --model pybullet --robot talos --out results/protocol-talos
+  rsg protocol --model mujoco --out results/protocol-g1-mujoco
 
 pushes (IHMC's push-recovery CI tests; left stance foot, cycle 4):
   forward 0 deg, backward 180 deg, inward 90 deg (towards the stance foot): single-support

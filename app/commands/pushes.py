@@ -34,6 +34,7 @@ examples:
   rsg pushes --seed eval --out results/pushes-g1-eval        # reported figures only
   rsg pushes --robot talos --controllers rsg --pushes 24 --seed eval --out results/talos
   rsg pushes --model lipm --robot g1 --pushes 200 --out results/pushes-g1-lipm
+  rsg pushes --model mujoco --seed dev --out results/pushes-g1-mujoco   # G1 on MuJoCo
 
 seeds: dev (= 1) for development and tuning, eval (= 2) for reported figures only.
 

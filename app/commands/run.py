@@ -10,7 +10,6 @@ from pathlib import Path
 import numpy as np
 
 from app.commands.arguments import (
-    RUN_MODELS,
     add_command,
     add_model_and_robot,
     add_out_arguments,
@@ -25,7 +24,7 @@ from app.results.run_files import write_results
 from app.runner import RunResult, run_closed_loop
 from app.scenarios import BUILT_IN, describe_push, load_scenario
 from app.setup.build import backend_reality, build_backend, resolve_robot
-from app.setup.overrides import ROBOT_MODELS, check_overrides
+from app.setup.overrides import ROBOT_MODELS, check_overrides, is_robot_model
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 from planner.types import Push
@@ -66,6 +65,7 @@ examples:
   rsg run --model lipm --scenario my_pushes.toml --out results/mine
   rsg run --model pybullet --controller placo-wpg --scenario walk --duration 4 --out results/wpg
   rsg run --reality randomized --reality-seed 3 --scenario walk --out results/g1-real3
+  rsg run --model mujoco --robot talos --scenario paper-fig6 --out results/talos-mujoco
 
 outputs in --out (a folder with an earlier run's results is refused without --overwrite):
   summary.json     verdict (recovered, fell, interrupted), steps, pushes, Lyapunov levels,
@@ -104,14 +104,14 @@ def verdict(result: RunResult) -> str:
 def add_parser(sub: argparse._SubParsersAction) -> None:
     """Add ``rsg run`` to the subcommands."""
     p = add_command(sub, "run", HELP, DESCRIPTION, EPILOG)
-    add_model_and_robot(p, "pybullet", reality_seed=True, models=RUN_MODELS)
+    add_model_and_robot(p, "pybullet", reality_seed=True)
     p.add_argument(
         "--controller",
         choices=(*CONTROLLERS, "placo-wpg"),
         default="rsg",
         help="rsg: step time and location adjusted; fixed-timing: location only; "
         "no-step: nominal steps; placo-wpg: placo's WalkPatternGenerator with "
-        "update_supports (--model pybullet only) (default: rsg)",
+        "update_supports (a full-robot model only) (default: rsg)",
     )
     p.add_argument(
         "--scenario",
@@ -141,7 +141,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="also write physics.csv: CoM, foot forces and CoPs, soles (position, tilt, "
         "yaw), and the controller's planned CoP, foot forces and sole targets at every "
-        "physics step (--model pybullet; touchdowns and impacts), and physics.png: the "
+        "physics step (--model pybullet or mujoco; touchdowns and impacts), and physics.png: the "
         "feet's forces and CoP against the plan, the soles' tilt and yaw",
     )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
@@ -166,11 +166,12 @@ def run(args: argparse.Namespace) -> int:
     overrides = tuple(args.overrides)
     robot = resolve_robot(args.model, args.robot)
     wpg = args.controller == "placo-wpg"
-    if wpg and args.model != "pybullet":
+    if wpg and not is_robot_model(args.model):
         raise ParameterError(
             "--controller",
             "placo-wpg",
-            "--model pybullet with placo-wpg (it drives the full robot's IK), or one of "
+            f"--model {' or '.join(ROBOT_MODELS)} with placo-wpg (it drives the full robot's "
+            "IK), or one of "
             f"{', '.join(CONTROLLERS)} on --model {args.model}",
         )
     if wpg and args.paper_rules:
@@ -201,7 +202,12 @@ def run(args: argparse.Namespace) -> int:
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
         backend, config, initial, planner = build_placo_wpg_backend(
-            robot or DEFAULT_ROBOT, overrides, physics_log, args.reality, args.reality_seed
+            robot or DEFAULT_ROBOT,
+            overrides,
+            physics_log,
+            args.reality,
+            args.reality_seed,
+            engine=args.model,
         )
     else:
         backend, config, initial = build_backend(

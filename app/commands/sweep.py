@@ -25,6 +25,7 @@ from app.results.worst_runs import (
     worst_sweep_runs,
     write_worst_replays,
 )
+from app.setup.overrides import is_robot_model
 from planner.parameters import CONTROLLERS
 
 HELP = "robustness map: largest recovered impulse per controller, direction and phase"
@@ -38,6 +39,7 @@ examples:
   rsg sweep --model lipm --directions 16 --out results/sweep
   rsg sweep --model lipm --controllers rsg,no-step --phases 0.5 --directions 8 --out /tmp/s
   rsg sweep --model pybullet --controllers rsg,placo-wpg --directions 4 --phases 0.25 --out r
+  rsg sweep --model mujoco --controllers rsg --directions 4 --phases 0.25 --out results/s-mj
   rsg sweep --backend ray --workers 64 --out results/sweep   # on a Ray cluster (RAY_ADDRESS)
   rsg sweep --model lipm --directions 8 --out results/sweep --monotonicity  # then 1/4, 1/2, 3/4
 
@@ -62,7 +64,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         type=csv_names,
         default=None,
         help=f"comma-separated, of {', '.join((*CONTROLLERS, PLACO_WPG))} (default: all that "
-        "fit the model; placo-wpg needs --model pybullet)",
+        "fit the model; placo-wpg needs a full-robot model)",
     )
     p.add_argument("--directions", type=int, default=16, help="push directions (default 16)")
     p.add_argument(
@@ -79,7 +81,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "--criterion",
         choices=("recovered", "no-fall"),
         default=None,
-        help="recovered (lipm default) or no-fall (pybullet default)",
+        help="recovered (lipm default) or no-fall (pybullet and mujoco default)",
     )
     p.add_argument(
         "--monotonicity",
@@ -95,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
     """Run ``rsg sweep``; returns 0."""
     controllers = args.controllers
     if controllers is None:
-        with_wpg = args.model == "pybullet"
+        with_wpg = is_robot_model(args.model)
         controllers = CONTROLLERS + ((PLACO_WPG,) if with_wpg else ())
     criterion = args.criterion or ("recovered" if args.model == "lipm" else "no-fall")
     spec = spec_from_args(SweepSpec, args, controllers=tuple(controllers), criterion=criterion)

@@ -9,10 +9,15 @@ Measured in one process, one after the other:
   box method, on problems sampled around the states the RSG meets (random DCM
   errors, both stance feet); the two solutions are compared (share within 1e-4 m,
   largest difference, and whether the exact one's objective is ever worse);
-- ``ik``, ``physics``: one whole-body IK solve and one PyBullet step, timed by
-  wrappers put around ``backend.ik.solve`` and ``backend.sim.step`` of a PyBullet
-  walk (the backend's files are not touched);
+- ``ik``, ``physics``: one whole-body IK solve and one physics step, timed by
+  wrappers put around ``backend.ik.solve`` and ``backend.sim.step`` of a full-robot
+  walk on PyBullet or MuJoCo (the backend's files are not touched);
 - ``loop``: one control tick of the full-robot closed loop, and its real-time factor.
+
+With several engines (``rsg bench --model pybullet,mujoco``) the robot's figures are
+taken for each, one engine after the other in the same process, so their real-time
+factors are measured side by side (``by_model``; the first engine's are also at the top
+level, as with one).
 
 - ``placo_wpg``: the same walk with the placo-wpg baseline (:mod:`app.baselines.placo_wpg`)
   as the planner: its planner tick (``rsg_tick``/``rsg_step_tick`` keys: ticks
@@ -146,8 +151,10 @@ def bench_robot(
     controller: str = "rsg",
     overrides: Overrides = (),
     reality: str = DEFAULT_PROFILE,
+    engine: str = "pybullet",
 ) -> dict:
-    """Time IK, physics and the whole loop of a PyBullet walk (it may fall; timed until then).
+    """Time IK, physics and the whole loop of a walk on ``engine`` (``pybullet`` or
+    ``mujoco``; it may fall; timed until then).
 
     With ``controller="placo-wpg"`` the planner is the placo baseline, and its
     ticks are timed too (``rsg_tick``/``rsg_step_tick`` keys: without/with a step).
@@ -159,13 +166,13 @@ def bench_robot(
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
         backend, config, initial, factory = build_placo_wpg_backend(
-            robot, overrides, reality=reality
+            robot, overrides, reality=reality, engine=engine
         )
     else:
         from app.setup.build import build_backend
 
         backend, config, initial = build_backend(
-            "pybullet", robot, controller, overrides=overrides, reality=reality
+            engine, robot, controller, overrides=overrides, reality=reality
         )
     ik_times: list[float] = []
     physics_times: list[float] = []
@@ -203,6 +210,7 @@ def bench_robot(
     planner_ticks = {"rsg_tick": stats(flow), "rsg_step_tick": stats(jump)}
     return {
         **({} if factory is None else planner_ticks),
+        "model": engine,
         "robot_planner_tick": stats(flow + jump),
         "ik": stats(ik_times),
         "physics": stats(physics_times),
@@ -219,10 +227,31 @@ def bench_robot(
 
 
 def bench_placo_wpg(
-    robot: str, duration: float, overrides: Overrides = (), reality: str = DEFAULT_PROFILE
+    robot: str,
+    duration: float,
+    overrides: Overrides = (),
+    reality: str = DEFAULT_PROFILE,
+    engine: str = "pybullet",
 ) -> dict:
     """The same figures for the placo-wpg baseline (its planner ticks on the robot)."""
-    return bench_robot(robot, duration, "placo-wpg", overrides, reality)
+    return bench_robot(robot, duration, "placo-wpg", overrides, reality, engine)
+
+
+def compare_engines(by_model: dict[str, dict]) -> str:
+    """One line per figure that differs by engine: the physics step's median [us], the
+    whole tick's median [us] and the real-time factor of each engine's walk, side by side."""
+    names = list(by_model)
+    rows = [
+        ("physics step median [us]", lambda r: _us((r.get("physics") or {}).get("median"))),
+        ("control tick median [us]", lambda r: _us((r.get("loop_tick") or {}).get("median"))),
+        ("real-time factor (rsg)", _rtf),
+        ("real-time factor (placo-wpg)", lambda r: _rtf(r.get("placo_wpg") or {})),
+        ("fell (rsg)", lambda r: "yes" if r.get("fell") else "no"),
+    ]
+    lines = [f"| engine | {' | '.join(names)} |", "|---|" + "---|" * len(names)]
+    for label, cell in rows:
+        lines.append(f"| {label} | {' | '.join(cell(by_model[n]) for n in names)} |")
+    return "\n".join(lines)
 
 
 ROWS = (

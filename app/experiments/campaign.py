@@ -304,7 +304,7 @@ def run_campaign_job(
     started = time.perf_counter()
     on = spec.twin() if job.twin else spec
     if on is None:
-        raise ParameterError("twin", job.key, "a campaign with a twin (--model pybullet)")
+        raise ParameterError("twin", job.key, "a campaign with a twin (a full-robot --model)")
     pushed = push.push(touchdown)
     seed = push_seed(spec, push.index)
     trial = PushRun(on, job.controller, seed)

@@ -10,6 +10,7 @@ from pathlib import Path
 
 from app.experiments.campaign import CampaignJob, CampaignPush, CampaignSpec, seed_name
 from app.experiments.outcome import OUTCOMES, RECOVERED_MEANS
+from app.setup.overrides import is_robot_model
 from planner.exceptions import RsgError
 
 FIGURES = ("push_time", "outcome", "fall_reason", "adjusted_steps", "settle_steps",
@@ -167,7 +168,7 @@ def format_summary(spec: CampaignSpec, summary: dict) -> str:
     """The summary as a table: outcomes, the twin's recoveries and the step ratio."""
     low, high = spec.impulse or (0.0, 0.0)
     where = f"{spec.robot or 'the paper point mass'} on {spec.model}"
-    if spec.model == "pybullet":
+    if is_robot_model(spec.model):
         where += f" (reality {spec.reality})"
     lines = [
         f"{spec.pushes} pushes, seed {seed_name(spec.seed)}, {where}: {low:g}-{high:g} N s over "

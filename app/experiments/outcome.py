@@ -27,6 +27,7 @@ from app.reality import RealityDraw
 from app.runner import RunResult
 from app.scenarios import Scenario
 from app.setup.build import backend_reality
+from app.setup.overrides import is_robot_model
 from planner.types import Push
 
 OUTCOMES = ("recovered", "survived", "fell")
@@ -78,7 +79,7 @@ class PushRun:
             spec, controller, seed
         )
         self.reality: RealityDraw | None = None
-        if spec.model == "pybullet":
+        if is_robot_model(spec.model):
             self.reality = backend_reality(self.backend, spec.reality, seed)
 
     def touchdown(self, cycle: int) -> float:

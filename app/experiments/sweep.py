@@ -36,7 +36,13 @@ from app.experiments.trial import SettledTrial, measured_touchdown, push_timing
 from app.reality import DEFAULT_PROFILE, check_profile, trial_seed
 from app.scenarios import Scenario
 from app.setup.build import resolve_robot
-from app.setup.overrides import Overrides, check_overrides
+from app.setup.overrides import (
+    MODELS,
+    ROBOT_MODELS,
+    Overrides,
+    check_overrides,
+    is_robot_model,
+)
 from planner.exceptions import ParameterError
 from planner.parameters import CONTROLLERS
 from planner.types import Push
@@ -51,9 +57,10 @@ class PushExperiment:
     model and robot they run on, and how they are built (:func:`build_controller`).
 
     Attributes:
-        model: ``lipm`` or ``pybullet``.
-        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on
-            ``pybullet`` and the paper's point mass on ``lipm``).
+        model: ``lipm`` or a full robot's engine (:data:`app.setup.overrides.ROBOT_MODELS`:
+            ``pybullet``, ``mujoco``).
+        robot: The robot (:func:`app.setup.build.resolve_robot`: ``None`` is G1 on a
+            full-robot model and the paper's point mass on ``lipm``).
         controllers: Controllers to compare.
         paper_rules: The paper's rules (:data:`app.setup.paper_rules.PAPER_RULES` off).
         fall_dcm_error: DCM error that counts as a fall on the LIPM [m]. The LIPM
@@ -99,7 +106,7 @@ def push_reality_seed(direction_deg: float, phase: float, impulse: float | None 
 def result_fields(fields: tuple[str, ...], spec: PushExperiment) -> tuple[str, ...]:
     """``fields`` that change a result of ``spec``: without ``reality`` on the LIPM (which
     ignores it), so an LIPM folder resumes whatever its profile."""
-    return fields if spec.model == "pybullet" else tuple(f for f in fields if f != "reality")
+    return fields if is_robot_model(spec.model) else tuple(f for f in fields if f != "reality")
 
 
 SWEEP_CONTROLLERS = (*CONTROLLERS, PLACO_WPG)
@@ -138,19 +145,19 @@ def check_pushes(
     Raises:
         ParameterError: naming the field, the value and what is allowed.
     """
-    if model not in ("lipm", "pybullet"):
-        raise ParameterError("model", model, "lipm or pybullet")
+    if model not in MODELS:
+        raise ParameterError("model", model, f"one of {', '.join(MODELS)}")
     bad = [c for c in controllers if c not in SWEEP_CONTROLLERS]
     if bad or not controllers or len(set(controllers)) != len(controllers):
         raise ParameterError(
             "controllers", ",".join(controllers), f"distinct of {SWEEP_CONTROLLERS}"
         )
-    if PLACO_WPG in controllers and model != "pybullet":
+    if PLACO_WPG in controllers and not is_robot_model(model):
         raise ParameterError(
             "controllers",
             PLACO_WPG,
-            "placo-wpg only with --model pybullet (it drives the full robot's IK; "
-            "on the LIPM it has no meaning)",
+            f"placo-wpg only with --model {' or '.join(ROBOT_MODELS)} (it drives the full "
+            "robot's IK; on the LIPM it has no meaning)",
         )
     if isinstance(directions, bool) or not (isinstance(directions, int) and 1 <= directions <= 360):
         raise ParameterError("directions", directions, "an integer in [1, 360]")
@@ -254,8 +261,9 @@ def build_controller(spec: PushExperiment, controller: str, seed: int = 0):  # n
         from app.baselines.placo_wpg import build_placo_wpg_backend
 
         return build_placo_wpg_backend(
-            spec.robot or DEFAULT_ROBOT, spec.overrides, reality=spec.reality, seed=seed
-        )
+            spec.robot or DEFAULT_ROBOT, spec.overrides, reality=spec.reality, seed=seed,
+            engine=spec.model,
+        )  # fmt: skip
     return (*_build_rsg(spec, controller, seed), None)
 
 

@@ -32,6 +32,7 @@ from app.results.run_files import summary_of
 from app.runner import run_closed_loop
 from app.scenarios import Scenario
 from app.setup.build import backend_reality
+from app.setup.overrides import is_robot_model
 from planner.exceptions import RsgError
 from planner.types import Push
 
@@ -146,7 +147,7 @@ def write_worst_replays(spec: Any, runs: list[dict], out: Path) -> list[dict]:
             backend.close()
         result.extra["reality"] = spec.reality
         result.extra["reality_seed"] = seed
-        draw = backend_reality(backend, spec.reality, seed) if spec.model == "pybullet" else None
+        draw = backend_reality(backend, spec.reality, seed) if is_robot_model(spec.model) else None
         if draw is not None:
             result.extra["reality_draw"] = draw.as_dict()
         folder = out / REPLAYS_DIR / replay_name(record)

@@ -10,6 +10,7 @@ from app.backends.physics_log import PhysicsLog
 from app.reality import DEFAULT_PROFILE, RealityDraw, check_profile, robot_reality
 from app.runner import walking_start
 from app.setup.overrides import (
+    MODELS,
     ROBOT_MODELS,
     Overrides,
     ParsedOverrides,
@@ -63,8 +64,8 @@ def build_backend(
     Raises:
         ParameterError: Unknown model, robot or reality profile, or a bad override.
     """
-    if model not in ("lipm", *ROBOT_MODELS):
-        raise ParameterError("--model", model, f"one of lipm, {', '.join(ROBOT_MODELS)}")
+    if model not in MODELS:
+        raise ParameterError("--model", model, f"one of {', '.join(MODELS)}")
     check_profile(reality)
     check_overrides(overrides, model, robot, controller, paper)
     if model == "lipm":
@@ -133,8 +134,8 @@ def build_robot_backend(  # noqa: ANN201
         backend_type = MujocoBackend
 
     check_profile(reality)
-    check_overrides(overrides, "pybullet", robot, controller, paper)
-    description, parsed = robot_with_overrides(robot, overrides)
+    check_overrides(overrides, engine, robot, controller, paper)
+    description, parsed = robot_with_overrides(robot, overrides, engine)
     config = planner_config_for(description, description.total_mass, controller)
     if paper:
         config = paper_rules(config)
@@ -165,15 +166,17 @@ def backend_reality(backend: object, profile: str, seed: int) -> RealityDraw | N
     return None
 
 
-def check_robot_overrides(robot: str | None, overrides: Overrides) -> None:
-    """Build ``robot`` once with ``overrides`` (then close it), so that a value out of
-    range is reported, as the backend or the planner words it, before a grid or a
-    sweep starts its worker processes.
+def check_robot_overrides(
+    robot: str | None, overrides: Overrides, engine: str = "pybullet"
+) -> None:
+    """Build ``robot`` once on ``engine`` with ``overrides`` (then close it), so that a
+    value out of range is reported, as the backend or the planner words it, before a
+    grid or a sweep starts its worker processes.
 
     Raises:
         ParameterError: Unknown robot, or a bad override.
     """
     if not overrides:
         return
-    backend, _, _ = build_robot_backend(robot or DEFAULT_ROBOT, "rsg", overrides)
+    backend, _, _ = build_robot_backend(robot or DEFAULT_ROBOT, "rsg", overrides, engine=engine)
     backend.close()

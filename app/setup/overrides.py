@@ -50,6 +50,14 @@ Overrides = tuple[tuple[str, str], ...]
 
 #: The models that simulate the whole robot (the same settings on each engine).
 ROBOT_MODELS = ("pybullet", "mujoco")
+#: Every model a command's ``--model`` may name: the point mass and the full robots.
+MODELS = ("lipm", *ROBOT_MODELS)
+
+
+def is_robot_model(model: str) -> bool:
+    """Whether ``model`` simulates the whole robot (any engine of :data:`ROBOT_MODELS`)."""
+    return model in ROBOT_MODELS
+
 
 #: Description fields that may be set: the numbers of the gait, the planner's bounds
 #: and timing, the fall thresholds, PyBullet's time step (the position gains follow,
@@ -253,8 +261,8 @@ def parse_overrides(
             raise ParameterError(
                 f"--set {name}",
                 text,
-                "it only with --model pybullet: a setting of the full robot (its physics, "
-                "IK or fall rule), which the point mass does not have",
+                f"it only with --model {' or '.join(ROBOT_MODELS)}: a setting of the full "
+                "robot (its physics, IK or fall rule), which the point mass does not have",
             )
         else:
             if paper:
