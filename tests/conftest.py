@@ -144,3 +144,19 @@ def output_lines(process: subprocess.Popen[str]) -> Iterator[list[str]]:
             process.kill()
             process.wait(10)
     reader.join(5)
+
+
+def assert_stands_one_second(backend, left: Foothold = LEFT, right: Foothold = RIGHT) -> None:
+    """Reset ``backend`` (a full robot) on ``left`` and ``right`` and hold it 1 s with the
+    DCM feedback: no fall, both feet on the ground, carrying m g within 2 % at the end."""
+    from app.backends.base import InitialCondition
+
+    state = backend.reset(InitialCondition(left, right, np.zeros(2), np.zeros(2)))
+    for tick in range(round(1.0 / backend.control_period)):
+        zmp = dcm_feedback_zmp(state, np.zeros(2), backend.description.pendulum_height)
+        planned = command(tick * backend.control_period, zmp, left, right)
+        state = backend.step(planned, np.zeros(2))
+        assert not backend.fall_status().fell, (tick, backend.fall_status())
+    total = sum(force for _, force in backend.foot_pressure().values())
+    assert abs(total - backend.mass * GRAVITY) < 0.02 * backend.mass * GRAVITY, total
+    assert backend.feet_in_contact() == {"left", "right"}

@@ -11,7 +11,7 @@ import pytest
 
 from app.cli import main
 from app.setup.build import build_backend
-from conftest import command, dcm_feedback_zmp
+from conftest import assert_stands_one_second
 from planner.types import Foothold
 
 GRAVITY = 9.81  # [m/s^2]
@@ -133,7 +133,6 @@ def test_talos_on_mujoco_has_pybullets_mass_and_stands():
     """Talos on MuJoCo: the mass PyBullet measures within 0.1 %, and 1 s standing under
     the whole-body controller (the ideal sensors, the test's DCM feedback) without a
     fall, on both feet, which carry m g within 2 % at the end."""
-    from app.backends.base import InitialCondition
 
     masses = {}
     for engine in ("pybullet", "mujoco"):
@@ -146,15 +145,7 @@ def test_talos_on_mujoco_has_pybullets_mass_and_stands():
     left = Foothold("left", np.array([0.0, half_width]))
     right = Foothold("right", np.array([0.0, -half_width]))
     try:
-        state = backend.reset(InitialCondition(left, right, np.zeros(2), np.zeros(2)))
-        for tick in range(round(1.0 / backend.control_period)):
-            zmp = dcm_feedback_zmp(state, np.zeros(2), backend.description.pendulum_height)
-            planned = command(tick * backend.control_period, zmp, left, right)
-            state = backend.step(planned, np.zeros(2))
-            assert not backend.fall_status().fell, (tick, backend.fall_status())
-        total = sum(force for _, force in backend.foot_pressure().values())
-        assert total == pytest.approx(backend.mass * GRAVITY, rel=0.02)
-        assert backend.feet_in_contact() == {"left", "right"}
+        assert_stands_one_second(backend, left, right)
     finally:
         backend.close()
 

@@ -246,24 +246,16 @@ def test_the_whole_body_controller_holds_g1_standing_on_mujoco(engines):
     """The full-robot backend on MuJoCo (``rsg run --model mujoco``): G1 stands 1 s under
     the whole-body controller with the test's DCM feedback (the ideal sensors), the feet
     carrying m g within 2 % at the end (a 10 ms tick's average, not a settled state)."""
-    from app.backends.base import InitialCondition
     from app.backends.mujoco import MujocoBackend
     from app.reality import robot_reality
     from app.setup.build import build_backend
-    from conftest import LEFT, RIGHT, command, dcm_feedback_zmp
+    from conftest import assert_stands_one_second
 
     backend, _, _ = build_backend("mujoco", None, "rsg", reality="ideal")
     try:
         assert isinstance(backend, MujocoBackend) and backend.name == "mujoco"
         assert isinstance(backend.sim, MujocoRobot)
         assert backend.reality == robot_reality(G1, "ideal", 0)
-        state = backend.reset(InitialCondition(LEFT, RIGHT, np.zeros(2), np.zeros(2)))
-        for tick in range(round(1.0 / backend.control_period)):
-            zmp = dcm_feedback_zmp(state, np.zeros(2), G1.pendulum_height)
-            state = backend.step(command(tick * backend.control_period, zmp), np.zeros(2))
-            assert not backend.fall_status().fell, (tick, backend.fall_status())
-        total = sum(force for _, force in backend.foot_pressure().values())
-        assert total == pytest.approx(backend.mass * GRAVITY, rel=0.02)
-        assert backend.feet_in_contact() == {"left", "right"}
+        assert_stands_one_second(backend)
     finally:
         backend.close()
