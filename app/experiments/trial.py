@@ -42,7 +42,7 @@ def measured_touchdown(runner, backend, config, initial, cycle: int, **options) 
     foot = initial.swing.foot if cycle % 2 == 1 else initial.stance.foot
     scenario = Scenario("walk", nominal + 2.5 * gait.step_duration)
     result = runner(backend, config, scenario, initial, qp_solver="exact", **options)
-    tick = getattr(backend, "control_period", 0.0)
+    tick = backend.control_period
     for record in result.steps if not result.fall.fell else ():
         event = record.event
         if event["t"] >= nominal - tick - 1e-9 and event["foot"] == foot:

@@ -287,12 +287,10 @@ class WholeBodyController:
         share = self.config.landing_compliance
         if share >= 1.0:
             return self.stiffness, self.damping
-        ahead = self.period  # the command holds over the next tick
-        time_since_step = command.time_since_step + ahead
-        landing_time = command.next_step_time - (command.time - command.time_since_step)
+        time_since_step, landing_time = self._swing_clock(command)
         since_landing = math.inf
         if self._step_time is not None:
-            since_landing = command.time - self._step_time + ahead
+            since_landing = command.time - self._step_time + self.period
         landing, landed = self.landing.compliant(landing_time - time_since_step, since_landing)
         scale = np.ones_like(self.stiffness)
         if landing and not command.double_support:
@@ -300,6 +298,12 @@ class WholeBodyController:
         if landed:
             scale[self._legs[stance]] = share
         return self.stiffness * scale, self.damping * scale
+
+    def _swing_clock(self, command: PlannerOutput) -> tuple[float, float]:
+        """Time since the step [s] at the end of this tick (the command holds over it), and
+        the planned landing time [s] on the same clock."""
+        landing_time = command.next_step_time - (command.time - command.time_since_step)
+        return command.time_since_step + self.period, landing_time
 
     def _estimate(self, measurement: RobotMeasurement, command: PlannerOutput) -> RobotState:
         """The estimate of ``measurement`` (made by :meth:`observe` unless it is new)."""
@@ -331,8 +335,7 @@ class WholeBodyController:
         swing sole on its trajectory to the announced step, with the landing rules, and
         turning from the yaw it stood at to the planner's heading (world x) over the swing."""
         dt = self.period
-        time_since_step = command.time_since_step + dt
-        landing_time = command.next_step_time - (command.time - command.time_since_step)
+        time_since_step, landing_time = self._swing_clock(command)
         position = self.swing.update(
             time_since_step, np.asarray(command.next_step.position, float), dt, landing_time
         )
